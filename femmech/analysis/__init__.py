@@ -1,0 +1,1 @@
+"""Analyses: modes, sweeps, stability, response."""

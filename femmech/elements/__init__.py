@@ -1,0 +1,1 @@
+"""Vectorised element matrices (one batched computation for all elements of a kind)."""

@@ -1,0 +1,272 @@
+"""Sparse symmetric eigen solver with shift-invert, Sturm-sequence checks and a dense path.
+
+Solves ``K x = λ M x`` (``λ = ω²``, rad²/s²) for symmetric positive semi-definite K and M.
+K may be singular (free-free structures): the shift σ is chosen below zero so that
+``K - σ M`` is regular and never a singular K is factorised. M may be singular
+(massless DOFs): their infinite eigenvalues are never returned.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from femmech.errors import FemmechWarning
+
+DENSE_BELOW = 400
+"""Systems with fewer DOFs than this are solved with dense LAPACK (``scipy.linalg.eigh``)."""
+
+
+@dataclass(frozen=True)
+class EigenResult:
+    """Eigenpairs of ``K x = λ M x``.
+
+    Attributes
+    ----------
+    omega2 : ndarray (n_modes,)
+        Eigenvalues λ = ω², rad²/s², ascending.
+    vectors : ndarray (n_dof, n_modes)
+        Mass-normalised (``XᵀMX = I``); sign fixed so the entry of largest magnitude is
+        positive.
+    method : str
+        ``"dense"`` (LAPACK) or ``"arpack"`` (shift-invert Lanczos).
+    sigma : float
+        Shift used, rad²/s².
+    residual : ndarray (n_modes,)
+        ``‖K x - λ M x‖ / (max(|λ|, |σ₀|) ‖M x‖)`` with σ₀ = :func:`default_shift`.
+    sturm_count : int or None
+        Number of eigenvalues below ``cut`` from the inertia of ``K - cut M``; it equals
+        the number of returned eigenvalues below ``cut`` when nothing was missed.
+    cut : float or None
+        The bound (rad²/s²) of the Sturm check.
+    """
+
+    omega2: np.ndarray
+    vectors: np.ndarray
+    method: str
+    sigma: float
+    residual: np.ndarray
+    sturm_count: int | None = None
+    cut: float | None = None
+
+
+def eigenvalue_scale(K, M) -> float:
+    """Typical eigenvalue magnitude ``median(diag K / diag M)`` over DOFs with mass, rad²/s²."""
+    dk = np.asarray(K.diagonal(), dtype=float)
+    dm = np.asarray(M.diagonal(), dtype=float)
+    ok = (dm > 0) & (dk > 0)
+    if not ok.any():
+        raise ValueError("the mass matrix has no positive diagonal entry: nothing can vibrate")
+    return float(np.median(dk[ok] / dm[ok]))
+
+
+def factorize(A):
+    """LU factorisation of a sparse matrix (SuperLU), returning an object with ``solve``.
+
+    Raises ValueError with the hint "singular" when A cannot be factorised.
+    """
+    try:
+        return spla.splu(sp.csc_matrix(A))
+    except RuntimeError as exc:
+        raise ValueError(f"matrix is singular and cannot be factorised ({exc})") from exc
+
+
+def inertia_below(K, M, cut: float) -> int | None:
+    """Number of eigenvalues of ``K x = λ M x`` below ``cut`` (Sylvester's law of inertia).
+
+    Counts negative pivots of a symmetric ``L D Lᵀ``-like factorisation of ``K - cut M``
+    (SuperLU in symmetric mode with diagonal pivoting). Returns None where the
+    factorisation pivoted off the diagonal, so that the count would not be the inertia.
+    """
+    A = sp.csc_matrix(K - cut * M)
+    try:
+        lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+    except RuntimeError:
+        return None
+    if not np.array_equal(lu.perm_r, lu.perm_c):
+        return None
+    return int(np.count_nonzero(lu.U.diagonal() < 0))
+
+
+def normalize_modes(vectors: np.ndarray, M) -> np.ndarray:
+    """Mass-normalise columns and make the largest-magnitude entry of each positive."""
+    norms = np.sqrt(np.einsum("ij,ij->j", vectors, M @ vectors))
+    vectors = vectors / norms
+    rows = np.argmax(np.abs(vectors), axis=0)
+    signs = np.sign(vectors[rows, np.arange(vectors.shape[1])])
+    return vectors * np.where(signs == 0, 1.0, signs)
+
+
+def residuals(K, M, omega2, vectors, floor: float) -> np.ndarray:
+    """Relative residuals ``‖K x - λ M x‖ / (max(|λ|, floor) ‖M x‖)`` per column.
+
+    ``floor`` (rad²/s², e.g. ``|σ|``) keeps the measure meaningful for rigid-body modes.
+    """
+    Kx = K @ vectors
+    Mx = M @ vectors
+    num = np.linalg.norm(Kx - Mx * omega2, axis=0)
+    den = np.maximum(np.abs(omega2), floor) * np.linalg.norm(Mx, axis=0)
+    return num / np.where(den > 0, den, 1.0)
+
+
+def _complete_cluster(omega2: np.ndarray, n_wanted: int, rtol: float = 1e-8) -> int:
+    """Count to return so that a cluster of equal eigenvalues is not cut at ``n_wanted``."""
+    n = n_wanted
+    scale = max(np.abs(omega2).max(), 1e-300)
+    while n < len(omega2) and abs(omega2[n] - omega2[n - 1]) <= rtol * scale:
+        n += 1
+    return n
+
+
+def _dense(K, M, sigma):
+    Kd = K.toarray() if sp.issparse(K) else np.asarray(K, dtype=float)
+    Md = M.toarray() if sp.issparse(M) else np.asarray(M, dtype=float)
+    try:
+        omega2, X = sla.eigh(Kd, Md)
+        return omega2, X
+    except np.linalg.LinAlgError:
+        pass  # singular mass: solve M x = μ (K - σ M) x, λ = σ + 1/μ
+    try:
+        mu, X = sla.eigh(Md, Kd - sigma * Md)
+    except np.linalg.LinAlgError as exc:
+        raise ValueError(
+            "K - sigma*M is not positive definite: some DOF has neither stiffness nor mass"
+        ) from exc
+    finite = mu > 1e-12 * np.abs(mu).max()
+    omega2 = sigma + 1.0 / mu[finite]
+    order = np.argsort(omega2)
+    return omega2[order], X[:, finite][:, order]
+
+
+def _arpack(K, M, k, sigma, lu):
+    n = K.shape[0]
+    v0 = np.random.default_rng(12345).standard_normal(n)
+    op = spla.LinearOperator((n, n), matvec=lu.solve, dtype=float)
+    omega2, X = spla.eigsh(sp.csr_matrix(K), k=k, M=sp.csr_matrix(M), sigma=sigma,
+                           which="LM", OPinv=op, v0=v0)
+    order = np.argsort(omega2)
+    return omega2[order], X[:, order]
+
+
+def default_shift(K, M) -> float:
+    """Shift below zero, ``-1e-6`` times :func:`eigenvalue_scale`, for modes from zero."""
+    return -1e-6 * eigenvalue_scale(K, M)
+
+
+def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] | None = None,
+                    sigma: float | None = None, dense_below: int = DENSE_BELOW,
+                    check: bool = True) -> EigenResult:
+    """Lowest eigenpairs, or all eigenpairs in a band, of ``K x = λ M x``.
+
+    Parameters
+    ----------
+    K, M : sparse or ndarray (n, n)
+        Symmetric stiffness (positive semi-definite) and mass (positive semi-definite).
+    n_modes : int, optional
+        Number of lowest eigenpairs. If the n-th eigenvalue is repeated, the whole
+        cluster is returned, so a degenerate subspace is never cut.
+    band : (float, float), optional
+        ``(λ_lo, λ_hi)`` in rad²/s²; all eigenpairs with ``λ_lo <= λ <= λ_hi``.
+    sigma : float, optional
+        Shift; default :func:`default_shift` (n_modes) or the band centre (band).
+    dense_below : int
+        Use dense LAPACK below this size.
+    check : bool
+        Verify by a Sturm-sequence count that no eigenvalue was missed (one extra
+        factorisation); raises RuntimeError if one was.
+
+    Returns
+    -------
+    EigenResult
+    """
+    if (n_modes is None) == (band is None):
+        raise ValueError("give exactly one of n_modes and band")
+    n = K.shape[0]
+    if n_modes is not None and not 0 < n_modes <= n:
+        raise ValueError(f"n_modes must lie in 1..{n} (the number of free DOFs), got {n_modes}")
+    if band is not None and not band[0] < band[1]:
+        raise ValueError(f"band must be (low, high) with low < high, got {band}")
+    shift = default_shift(K, M) if sigma is None else float(sigma)
+    if n < dense_below:
+        omega2, X = _dense(K, M, shift)
+        result = _select(omega2, X, n_modes, band)
+        omega2, X = result
+        method = "dense"
+    elif n_modes is not None:
+        omega2, X = _sparse_lowest(K, M, n_modes, shift)
+        method = "arpack"
+    else:
+        omega2, X, shift = _sparse_band(K, M, band, sigma)
+        method = "arpack"
+    X = normalize_modes(X, M)
+    res = residuals(K, M, omega2, X, abs(default_shift(K, M)))
+    if res.size and res.max() > 1e-6:
+        warnings.warn(f"eigen solve: largest relative residual {res.max():.2e} exceeds 1e-6",
+                      FemmechWarning, stacklevel=2)
+    count, cut = (None, None)
+    if check and method == "arpack" and n_modes is not None and omega2.size:
+        cut = _cut_above(omega2[-1], K, M)
+        count = inertia_below(K, M, cut)
+        if count is not None and count != omega2.size:
+            raise RuntimeError(
+                f"Sturm check: {count} eigenvalues lie below {cut:.6g} rad²/s² but the solver"
+                f" returned {omega2.size}; retry with a larger n_modes or another sigma"
+            )
+    return EigenResult(omega2, X, method, shift, res, count, cut)
+
+
+def _cut_above(lam: float, K, M) -> float:
+    return lam + 1e-6 * max(abs(lam), 1e-6 * eigenvalue_scale(K, M))
+
+
+def _select(omega2, X, n_modes, band):
+    if band is not None:
+        keep = (omega2 >= band[0]) & (omega2 <= band[1])
+        return omega2[keep], X[:, keep]
+    count = _complete_cluster(omega2, min(n_modes, len(omega2)))
+    return omega2[:count], X[:, :count]
+
+
+def _sparse_lowest(K, M, n_modes, sigma):
+    n = K.shape[0]
+    lu = factorize(K - sigma * M)
+    guard = min(max(4, n_modes // 5), n - 1 - n_modes)
+    k = n_modes + max(guard, 0)
+    if k >= n - 1:
+        raise ValueError(f"{n_modes} modes of a {n}-DOF system: use the dense path"
+                         " (raise dense_below) or ask for fewer modes")
+    omega2, X = _arpack(K, M, k, sigma, lu)
+    count = _complete_cluster(omega2, n_modes)
+    if count == k:
+        raise RuntimeError("a cluster of repeated eigenvalues fills all computed modes;"
+                           " ask for more modes")
+    return omega2[:count], X[:, :count]
+
+
+def _sparse_band(K, M, band, sigma):
+    lo, hi = band
+    n = K.shape[0]
+    below_hi = inertia_below(K, M, hi)
+    below_lo = inertia_below(K, M, lo) if lo > default_shift(K, M) else 0
+    shift = 0.5 * (lo + hi) if sigma is None else float(sigma)
+    if below_hi is None or below_lo is None:
+        raise RuntimeError("band search needs a Sturm count, which failed for this pencil;"
+                           " ask for n_modes instead")
+    count = below_hi - below_lo
+    if count == 0:
+        return np.empty(0), np.empty((n, 0)), shift
+    if count + 2 >= n - 1:
+        raise ValueError(f"the band holds {count} of {n} eigenvalues: use the dense path")
+    lu = factorize(K - shift * M)
+    omega2, X = _arpack(K, M, min(count + 2, n - 2), shift, lu)
+    keep = (omega2 >= lo) & (omega2 <= hi)
+    if keep.sum() != count:
+        raise RuntimeError(f"band search found {keep.sum()} of {count} eigenvalues"
+                           f" (Sturm count) in [{lo:.6g}, {hi:.6g}] rad²/s²")
+    return omega2[keep], X[:, keep], shift

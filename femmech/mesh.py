@@ -1,0 +1,129 @@
+"""The mesh: points, cells by type, named cell sets and node sets (meshio conventions)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+NODES_PER_CELL = {
+    "vertex": 1, "line": 2, "line3": 3, "triangle": 3, "quad": 4, "triangle6": 6,
+    "quad8": 8, "quad9": 9, "tetra": 4, "tetra10": 10, "hexahedron": 8, "hexahedron20": 20,
+    "hexahedron27": 27, "wedge": 6,
+}
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """Nodes, cells and named groups.
+
+    Attributes
+    ----------
+    points : ndarray (n_nodes, 3), m
+    cells : dict[str, ndarray (n_cells, nodes_per_cell)]
+        0-based connectivity by meshio cell type (``"line"``, ``"triangle"``, ...).
+    cell_sets : dict[str, dict[str, ndarray]]
+        Group name → cell type → indices into ``cells[type]``.
+    node_sets : dict[str, ndarray]
+        Group name → node indices.
+
+    Raises
+    ------
+    ValueError
+        Non-finite coordinates, cells referencing missing nodes, or groups referencing
+        missing cells, each naming the offending item.
+    """
+
+    points: np.ndarray
+    cells: dict[str, np.ndarray]
+    cell_sets: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    node_sets: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def __post_init__(self):
+        points = np.asarray(self.points, dtype=float)
+        if points.ndim != 2 or points.shape[1] not in (2, 3):
+            raise ValueError(f"points must have shape (n_nodes, 3), got {points.shape}")
+        if points.shape[1] == 2:
+            points = np.column_stack([points, np.zeros(len(points))])
+        bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
+        if bad.size:
+            raise ValueError(f"node {bad[0]} has non-finite coordinates {points[bad[0]]}")
+        object.__setattr__(self, "points", points)
+        object.__setattr__(self, "cells", {k: _check_cells(k, v, len(points))
+                                           for k, v in self.cells.items()})
+        sets = {}
+        for name, by_type in self.cell_sets.items():
+            sets[name] = {}
+            for kind, idx in by_type.items():
+                idx = np.asarray(idx, dtype=np.int64).ravel()
+                n_cells = len(self.cells.get(kind, ()))
+                if idx.size and (idx.min() < 0 or idx.max() >= n_cells):
+                    raise ValueError(f"cell set {name!r} references {kind} cell"
+                                     f" {idx.max()}, but the mesh has {n_cells}")
+                sets[name][kind] = idx
+        object.__setattr__(self, "cell_sets", sets)
+        node_sets = {}
+        for name, nodes in self.node_sets.items():
+            nodes = np.asarray(nodes, dtype=np.int64).ravel()
+            if nodes.size and (nodes.min() < 0 or nodes.max() >= len(points)):
+                raise ValueError(f"node set {name!r} references node {nodes.max()},"
+                                 f" but the mesh has {len(points)} nodes")
+            node_sets[name] = nodes
+        object.__setattr__(self, "node_sets", node_sets)
+
+    @property
+    def n_nodes(self) -> int:
+        """Number of nodes."""
+        return len(self.points)
+
+    @classmethod
+    def from_lines(cls, points, lines, cell_sets=None, node_sets=None) -> Mesh:
+        """Mesh of line cells from arrays.
+
+        Parameters
+        ----------
+        points : array_like (n_nodes, 3), m
+        lines : array_like (n_elements, 2), int
+        cell_sets : dict[str, array_like of int], optional
+            Group name → element indices. Default: one group ``"all"``.
+        node_sets : dict[str, array_like of int], optional
+        """
+        lines = np.asarray(lines)
+        if cell_sets is None:
+            cell_sets = {"all": np.arange(len(lines))}
+        return cls(points, {"line": lines},
+                   {name: {"line": idx} for name, idx in cell_sets.items()},
+                   dict(node_sets or {}))
+
+    def group_names(self) -> list[str]:
+        """All cell-set and node-set names."""
+        return sorted(set(self.cell_sets) | set(self.node_sets))
+
+    def nodes_of(self, name: str) -> np.ndarray:
+        """Node indices of a node set, or the nodes of a cell set's cells (sorted)."""
+        if name in self.node_sets:
+            return self.node_sets[name]
+        if name in self.cell_sets:
+            parts = [self.cells[kind][idx].ravel() for kind, idx in self.cell_sets[name].items()]
+            return np.unique(np.concatenate(parts)) if parts else np.empty(0, dtype=np.int64)
+        raise ValueError(f"unknown group {name!r}; the mesh has {self.group_names()}")
+
+
+def _check_cells(kind: str, cells, n_nodes: int) -> np.ndarray:
+    cells = np.asarray(cells)
+    if kind not in NODES_PER_CELL:
+        raise ValueError(f"unsupported cell type {kind!r}")
+    if cells.size == 0:
+        return np.empty((0, NODES_PER_CELL[kind]), dtype=np.int64)
+    if not np.issubdtype(cells.dtype, np.integer):
+        raise ValueError(f"{kind} connectivity must be integer, got {cells.dtype}")
+    cells = cells.astype(np.int64)
+    if cells.ndim != 2 or cells.shape[1] != NODES_PER_CELL[kind]:
+        raise ValueError(f"{kind} cells must have shape (n, {NODES_PER_CELL[kind]}),"
+                         f" got {cells.shape}")
+    bad = np.flatnonzero((cells < 0).any(axis=1) | (cells >= n_nodes).any(axis=1))
+    if bad.size:
+        e = bad[0]
+        raise ValueError(f"{kind} cell {e} references node {cells[e].tolist()},"
+                         f" but the mesh has {n_nodes} nodes")
+    return cells

@@ -1,0 +1,307 @@
+"""The FE model: mesh + element properties + lumped items + constraints → sparse K, M.
+
+Symbols: K stiffness (N/m, N m/rad), M mass (kg, kg m²), both (n_dof, n_dof) CSR with
+``n_dof = 6 n_nodes``; constraints are eliminated by ``u = T u_free`` so that the free
+system is ``Tᵀ K T``, ``Tᵀ M T``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+from femmech.assembly import assemble
+from femmech.constraints import RigidLink, Support, constraint_transform, fixed_mask
+from femmech.dofs import DOF_PER_NODE, element_dofs, node_dofs
+from femmech.elements.beam import beam_matrices, local_frames
+from femmech.lumped import PointMass, Spring
+from femmech.materials import Material
+from femmech.mesh import Mesh
+from femmech.sections import BeamSection
+
+
+@dataclass(frozen=True)
+class BeamProperty:
+    """Section, material and orientation of the beam elements of one group.
+
+    Attributes
+    ----------
+    section : BeamSection
+    material : Material
+    orientation : array_like (3,), optional
+        Vector in the local x-y plane (see :func:`femmech.elements.beam.local_frames`).
+    shear : bool
+        Timoshenko shear deformation; False gives Euler-Bernoulli bending.
+    rotary_inertia : bool
+        Include the rotary inertia of bending.
+    """
+
+    section: BeamSection
+    material: Material
+    orientation: object = None
+    shear: bool = True
+    rotary_inertia: bool = True
+
+
+@dataclass(frozen=True)
+class BeamSet:
+    """Beam elements of a model, for recovery and drawing.
+
+    Attributes
+    ----------
+    cells : ndarray (n_elements, 2)
+    frames : ndarray (n_elements, 3, 3)
+        Local axes (rows) in global coordinates.
+    length : ndarray (n_elements,), m
+    radius : ndarray (n_elements,), m
+        Drawing radius (half the largest section dimension).
+    group : ndarray (n_elements,) of str
+    """
+
+    cells: np.ndarray
+    frames: np.ndarray
+    length: np.ndarray
+    radius: np.ndarray
+    group: np.ndarray
+
+
+@dataclass(frozen=True)
+class FEModel:
+    """Assembled FE model.
+
+    Attributes
+    ----------
+    mesh : Mesh
+    K, M : scipy.sparse.csr_matrix (n_dof, n_dof)
+        Unconstrained stiffness and mass.
+    T : scipy.sparse.csr_matrix (n_dof, n_free)
+        Constraint transformation, ``u = T u_free``.
+    free : ndarray (n_free,)
+        Independent DOFs (the columns of T are the unit vectors of these DOFs, plus the
+        rigid-link contributions).
+    beams : BeamSet
+    """
+
+    mesh: Mesh
+    K: sp.csr_matrix
+    M: sp.csr_matrix
+    T: sp.csr_matrix
+    free: np.ndarray
+    beams: BeamSet
+    K_free: sp.csr_matrix = field(repr=False)
+    M_free: sp.csr_matrix = field(repr=False)
+
+    @property
+    def n_dof(self) -> int:
+        """Number of DOFs before constraints (6 per node)."""
+        return self.K.shape[0]
+
+    @property
+    def n_free(self) -> int:
+        """Number of independent DOFs after supports and rigid links."""
+        return self.T.shape[1]
+
+    def expand(self, u_free: np.ndarray) -> np.ndarray:
+        """Full DOF vector(s) (n_dof, ...) from free DOF vector(s) (n_free, ...)."""
+        return self.T @ u_free
+
+    def total_mass(self) -> float:
+        """Translational mass, kg: ``eᵀ M e / 3`` summed over the three rigid translations."""
+        e = np.zeros((self.n_dof, 3))
+        for i in range(3):
+            e[i::DOF_PER_NODE, i] = 1.0
+        return float(np.trace(e.T @ (self.M @ e)) / 3.0)
+
+
+def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(),
+                supports=(), rigid_links=()) -> FEModel:
+    """Assemble an :class:`FEModel`.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    beams : dict[str, BeamProperty]
+        Cell-set name → property of its line elements; every line element needs exactly one.
+    masses : sequence of PointMass
+    springs : sequence of Spring
+    supports : sequence of Support
+    rigid_links : sequence of RigidLink
+
+    Raises
+    ------
+    ValueError
+        Naming the offending element, node or group: unknown group names, elements
+        without or with two properties, unused nodes, coincident nodes that no spring or
+        rigid link joins, zero-length elements, orientation vectors along an element.
+    """
+    _check_types(beams, masses, springs, supports, rigid_links)
+    beam_set, Ke, Me, edofs = _beam_blocks(mesh, beams)
+    n_dof = DOF_PER_NODE * mesh.n_nodes
+    stiff_blocks = [(edofs, Ke)]
+    mass_blocks = [(edofs, Me)]
+    used = np.zeros(mesh.n_nodes, dtype=bool)
+    used[beam_set.cells.ravel()] = True
+    joined = []
+    for item in masses:
+        node = node_index(mesh, item.node, "point mass")
+        mass_blocks.append((node_dofs([node])[None, :], item.matrix()[None]))
+        used[node] = True
+    for item in springs:
+        k = item.matrix()
+        a = node_index(mesh, item.node_a, "spring")
+        used[a] = True
+        if item.node_b is None:
+            stiff_blocks.append((node_dofs([a])[None, :], k[None]))
+            continue
+        b = node_index(mesh, item.node_b, "spring")
+        if a == b:
+            raise ValueError(f"spring {item.node_a!r}-{item.node_b!r} connects node {a} to itself")
+        used[b] = True
+        joined.append((a, b))
+        stiff_blocks.append((node_dofs([a, b])[None, :], np.block([[k, -k], [-k, k]])[None]))
+    masters, slaves = _rigid_pairs(mesh, rigid_links)
+    used[masters] = True
+    used[slaves] = True
+    joined.extend(zip(masters.tolist(), slaves.tolist(), strict=True))
+    _check_nodes(mesh, used, joined)
+    fixed = np.zeros(n_dof, dtype=bool)
+    for item in supports:
+        fixed |= fixed_mask(mesh.n_nodes, node_indices(mesh, item.nodes, "support"), item.dofs)
+    T, free = constraint_transform(mesh.points, fixed, masters, slaves)
+    K = assemble(stiff_blocks, n_dof)
+    M = assemble(mass_blocks, n_dof)
+    Tt = T.T.tocsr()
+    return FEModel(mesh, K, M, T, free, beam_set, (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr())
+
+
+def _check_types(beams, masses, springs, supports, rigid_links):
+    for label, items, kind in (("masses", masses, PointMass), ("springs", springs, Spring),
+                               ("supports", supports, Support),
+                               ("rigid_links", rigid_links, RigidLink)):
+        for i, item in enumerate(items):
+            if not isinstance(item, kind):
+                raise TypeError(f"{label}[{i}] must be a {kind.__name__}, got {type(item).__name__}")
+    for name, prop in beams.items():
+        if not isinstance(prop, BeamProperty):
+            raise TypeError(f"beams[{name!r}] must be a BeamProperty, got {type(prop).__name__}")
+        if not isinstance(prop.section, BeamSection) or not isinstance(prop.material, Material):
+            raise TypeError(f"beams[{name!r}]: section must be a BeamSection and material a"
+                            " Material")
+
+
+def _beam_blocks(mesh: Mesh, beams: dict[str, BeamProperty]):
+    unsupported = [k for k, v in mesh.cells.items() if k != "line" and len(v)]
+    if unsupported:
+        raise ValueError(f"the mesh has {unsupported} cells, which have no element property;"
+                         " only line (beam) cells are supported by build_model")
+    lines = mesh.cells.get("line", np.empty((0, 2), dtype=np.int64))
+    owner = np.full(len(lines), -1)
+    names = list(beams)
+    for g, name in enumerate(names):
+        if name not in mesh.cell_sets:
+            raise ValueError(f"beam property for unknown group {name!r};"
+                             f" the mesh has cell sets {sorted(mesh.cell_sets)}")
+        idx = mesh.cell_sets[name].get("line", np.empty(0, dtype=np.int64))
+        twice = idx[owner[idx] >= 0]
+        if twice.size:
+            raise ValueError(f"line element {twice[0]} is in groups {names[owner[twice[0]]]!r}"
+                             f" and {name!r}, both with beam properties")
+        owner[idx] = g
+    missing = np.flatnonzero(owner < 0)
+    if missing.size:
+        e = missing[0]
+        groups = [n for n, s in mesh.cell_sets.items() if e in s.get("line", ())]
+        raise ValueError(f"line element {e} (nodes {lines[e].tolist()}) has no beam property"
+                         f" ({missing.size} such elements); its groups: {groups}")
+    props = [beams[n] for n in names]
+    orient = _orientations(mesh, lines, owner, props)
+    R, length = local_frames(mesh.points, lines, orient)
+    table = np.array([_property_row(p) for p in props]).reshape(len(props), 12)
+    rows = table[owner] if len(lines) else np.zeros((0, 12))
+    E, G, rho, A, Iy, Iz, J, Ip, Asy, Asz, rot, radius = rows.T
+    Ke, Me = beam_matrices(mesh.points, lines, orient, E, G, rho, A, Iy, Iz, J, Ip, Asy, Asz,
+                           rotary_inertia=rot)
+    group = np.array(names, dtype=object)[owner] if len(lines) else np.empty(0, dtype=object)
+    return BeamSet(lines, R, length, radius, group), Ke, Me, element_dofs(lines)
+
+
+def _property_row(p: BeamProperty) -> list[float]:
+    s, m = p.section, p.material
+    inf = np.inf
+    asy = s.Asy if (p.shear and s.Asy is not None) else inf
+    asz = s.Asz if (p.shear and s.Asz is not None) else inf
+    return [m.E, m.shear_modulus, m.rho, s.A, s.Iy, s.Iz, s.J, s.polar_moment, asy, asz,
+            float(p.rotary_inertia), s.draw_radius]
+
+
+def _orientations(mesh, lines, owner, props) -> np.ndarray:
+    """Per-element orientation vectors; groups without one use the default rule."""
+    R_default, _ = local_frames(mesh.points, lines, None) if len(lines) else (np.zeros((0, 3, 3)),
+                                                                              None)
+    orient = R_default[:, 1, :].copy()
+    for g, p in enumerate(props):
+        if p.orientation is not None:
+            v = np.asarray(p.orientation, dtype=float)
+            if v.shape != (3,) or not np.isfinite(v).all() or not np.any(v):
+                raise ValueError(f"orientation of a beam group must be a non-zero 3-vector,"
+                                 f" got {p.orientation!r}")
+            orient[owner == g] = v
+    return orient
+
+
+def node_index(mesh: Mesh, ref, what: str) -> int:
+    """Node index from an int or from a group that holds exactly one node."""
+    nodes = node_indices(mesh, ref, what)
+    if nodes.size != 1:
+        raise ValueError(f"{what}: group {ref!r} holds {nodes.size} nodes; exactly one expected")
+    return int(nodes[0])
+
+
+def node_indices(mesh: Mesh, ref, what: str) -> np.ndarray:
+    """Node indices from a group name, an int or a sequence of ints (checked)."""
+    if isinstance(ref, str):
+        try:
+            return mesh.nodes_of(ref)
+        except ValueError as exc:
+            raise ValueError(f"{what}: {exc}") from None
+    nodes = np.atleast_1d(np.asarray(ref))
+    if not np.issubdtype(nodes.dtype, np.integer):
+        raise TypeError(f"{what}: nodes must be a group name or node indices, got {ref!r}")
+    bad = nodes[(nodes < 0) | (nodes >= mesh.n_nodes)]
+    if bad.size:
+        raise ValueError(f"{what}: node {bad[0]} does not exist (the mesh has"
+                         f" {mesh.n_nodes} nodes)")
+    return nodes.astype(np.int64)
+
+
+def _rigid_pairs(mesh: Mesh, links):
+    masters, slaves = [], []
+    for link in links:
+        m = node_index(mesh, link.master, "rigid link master")
+        s = node_indices(mesh, link.slaves, "rigid link slaves")
+        s = s[s != m]
+        if s.size == 0:
+            raise ValueError(f"rigid link with master {link.master!r} has no slave nodes")
+        masters.append(np.full(s.size, m))
+        slaves.append(s)
+    if not masters:
+        return np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
+    return np.concatenate(masters), np.concatenate(slaves)
+
+
+def _check_nodes(mesh: Mesh, used: np.ndarray, joined) -> None:
+    unused = np.flatnonzero(~used)
+    if unused.size:
+        raise ValueError(f"node {unused[0]} at {mesh.points[unused[0]].tolist()} is not used by"
+                         f" any element, mass, spring or rigid link ({unused.size} unused nodes)")
+    scale = max(float(np.ptp(mesh.points, axis=0).max()), 1e-300)
+    pairs = cKDTree(mesh.points).query_pairs(1e-9 * scale, output_type="ndarray")
+    if pairs.size:
+        ok = {tuple(sorted(p)) for p in joined}
+        for a, b in pairs:
+            if (min(a, b), max(a, b)) not in ok:
+                raise ValueError(f"nodes {a} and {b} coincide at {mesh.points[a].tolist()} but no"
+                                 " spring or rigid link joins them; merge them (duplicate nodes)")
