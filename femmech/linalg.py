@@ -65,13 +65,21 @@ def eigenvalue_scale(K, M) -> float:
     return float(np.median(dk[ok] / dm[ok]))
 
 
-def factorize(A):
-    """LU factorisation of a sparse matrix (SuperLU), returning an object with ``solve``.
+def factorize(A, pivot_threshold: float = 0.0):
+    """Sparse LU of a symmetric matrix (SuperLU in symmetric mode), with ``solve``.
+
+    Uses a symmetric fill-reducing ordering (minimum degree on ``Aᵀ + A``) and diagonal
+    pivots, so the factors keep the symmetric structure: on a 120k-DOF space frame this
+    is 14x less fill and 70x faster than SuperLU's default partial pivoting (benchmarks).
+    ``pivot_threshold = 0`` is stable for positive definite A (shift below the spectrum);
+    for an indefinite A (shift inside the spectrum) pass e.g. 0.01 so that small
+    diagonal pivots are rejected.
 
     Raises ValueError with the hint "singular" when A cannot be factorised.
     """
     try:
-        return spla.splu(sp.csc_matrix(A))
+        return spla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A",
+                         diag_pivot_thresh=pivot_threshold, options={"SymmetricMode": True})
     except RuntimeError as exc:
         raise ValueError(f"matrix is singular and cannot be factorised ({exc})") from exc
 
@@ -83,11 +91,9 @@ def inertia_below(K, M, cut: float) -> int | None:
     (SuperLU in symmetric mode with diagonal pivoting). Returns None where the
     factorisation pivoted off the diagonal, so that the count would not be the inertia.
     """
-    A = sp.csc_matrix(K - cut * M)
     try:
-        lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                       options={"SymmetricMode": True})
-    except RuntimeError:
+        lu = factorize(K - cut * M)
+    except ValueError:
         return None
     if not np.array_equal(lu.perm_r, lu.perm_c):
         return None
@@ -115,10 +121,18 @@ def residuals(K, M, omega2, vectors, floor: float) -> np.ndarray:
     return num / np.where(den > 0, den, 1.0)
 
 
-def _complete_cluster(omega2: np.ndarray, n_wanted: int, rtol: float = 1e-8) -> int:
-    """Count to return so that a cluster of equal eigenvalues is not cut at ``n_wanted``."""
+def _complete_cluster(omega2: np.ndarray, n_wanted: int, rtol: float = 1e-6) -> int:
+    """Count to return so that a cluster of equal eigenvalues is not cut at ``n_wanted``.
+
+    Equal means within ``rtol`` of the n-th eigenvalue, with a floor of ``1e-6`` times the
+    largest computed one, so that rigid-body clusters (~0) and the dense solver's absolute
+    round-off (~eps times the largest eigenvalue, up to ~1e-6 relative for the lowest modes
+    of fine meshes) are covered. Scaling by the largest eigenvalue alone merged distinct low
+    modes of pencils with a wide spectrum (returned 63 modes for 5).
+    """
     n = n_wanted
-    scale = max(np.abs(omega2).max(), 1e-300)
+    largest = np.abs(omega2).max()
+    scale = max(abs(omega2[n_wanted - 1]), 1e-6 * largest, 1e-300)
     while n < len(omega2) and abs(omega2[n] - omega2[n - 1]) <= rtol * scale:
         n += 1
     return n
@@ -263,7 +277,7 @@ def _sparse_band(K, M, band, sigma):
         return np.empty(0), np.empty((n, 0)), shift
     if count + 2 >= n - 1:
         raise ValueError(f"the band holds {count} of {n} eigenvalues: use the dense path")
-    lu = factorize(K - shift * M)
+    lu = factorize(K - shift * M, pivot_threshold=0.01)
     omega2, X = _arpack(K, M, min(count + 2, n - 2), shift, lu)
     keep = (omega2 >= lo) & (omega2 <= hi)
     if keep.sum() != count:

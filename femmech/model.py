@@ -183,7 +183,8 @@ def _check_types(beams, masses, springs, supports, rigid_links):
                                ("rigid_links", rigid_links, RigidLink)):
         for i, item in enumerate(items):
             if not isinstance(item, kind):
-                raise TypeError(f"{label}[{i}] must be a {kind.__name__}, got {type(item).__name__}")
+                raise TypeError(f"{label}[{i}] must be a {kind.__name__},"
+                                f" got {type(item).__name__}")
     for name, prop in beams.items():
         if not isinstance(prop, BeamProperty):
             raise TypeError(f"beams[{name!r}] must be a BeamProperty, got {type(prop).__name__}")

@@ -11,9 +11,9 @@ from femmech.model import FEModel
 
 RIGID_TOL = 1e-12
 """Eigenvalues with ``|ω²| <= RIGID_TOL * scale`` are rigid-body modes (scale: see
-:func:`femmech.linalg.eigenvalue_scale`, roughly the largest element eigenvalue). Computed rigid-body
-eigenvalues are ~1e-17 of the scale; elastic modes of 1e-12 of the scale are ~1e-6 of the
-highest frequencies."""
+:func:`femmech.linalg.eigenvalue_scale`, roughly the largest element eigenvalue).
+Computed rigid-body eigenvalues are ~1e-17 of the scale; elastic modes of 1e-12 of the
+scale are ~1e-6 of the highest frequencies."""
 
 
 @dataclass(frozen=True)

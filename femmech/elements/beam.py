@@ -36,8 +36,9 @@ def local_frames(points: np.ndarray, cells: np.ndarray, orientation=None):
     points : ndarray (n_nodes, 3), m
     cells : ndarray (n_elements, 2), int
     orientation : array_like (3,) or (n_elements, 3), optional
-        Vector in the local x-y plane. Default: global z, or global x for elements
-        within 2.6° of the z axis (|cos| > 0.999).
+        Vector in the local x-y plane. Default: ``ẑ × x`` (horizontal), so that local z
+        points upwards and a section's "height" is vertical; for elements within 2.6°
+        of the z axis (|cos| > 0.999) global y, so that local z is ∓ global x.
 
     Returns
     -------
@@ -63,8 +64,8 @@ def local_frames(points: np.ndarray, cells: np.ndarray, orientation=None):
         )
     ex = axis / length[:, None]
     if orientation is None:
-        ref = np.tile([0.0, 0.0, 1.0], (len(cells), 1))
-        ref[np.abs(ex[:, 2]) > 0.999] = [1.0, 0.0, 0.0]
+        ref = np.cross([0.0, 0.0, 1.0], ex)
+        ref[np.abs(ex[:, 2]) > 0.999] = [0.0, 1.0, 0.0]
     else:
         ref = np.broadcast_to(np.asarray(orientation, dtype=float), ex.shape)
     ey = ref - np.sum(ref * ex, axis=1)[:, None] * ex

@@ -1,0 +1,73 @@
+"""Parametric meshes of machine-like frames, for examples, tests and benchmarks."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from femmech.mesh import Mesh
+
+
+def grid_frame(bays=(2, 2, 2), size=(1.0, 1.0, 1.0), subdivisions: int = 1) -> Mesh:
+    """Space frame of beams on a regular grid of joints, members subdivided into elements.
+
+    Parameters
+    ----------
+    bays : (int, int, int)
+        Number of bays along x, y, z (joints: ``(bx + 1)(by + 1)(bz + 1)``).
+    size : (float, float, float)
+        Overall dimensions, m.
+    subdivisions : int
+        Elements per member (>= 1).
+
+    Returns
+    -------
+    Mesh
+        Line cells with cell sets ``"beams_x"``, ``"beams_y"`` (horizontal members) and
+        ``"columns"`` (along z), and node sets ``"base"`` (joints at z = 0), ``"top"``
+        (joints at the top) and ``"joints"``. Number of nodes:
+        ``joints + (subdivisions - 1) * members``.
+    """
+    bays = tuple(int(b) for b in bays)
+    if len(bays) != 3 or min(bays) < 0 or sum(b > 0 for b in bays) == 0:
+        raise ValueError(f"bays must be three non-negative integers, not all zero, got {bays}")
+    if subdivisions < 1:
+        raise ValueError(f"subdivisions must be >= 1, got {subdivisions}")
+    shape = tuple(b + 1 for b in bays)
+    axes = [np.linspace(0.0, s, n) for s, n in zip(size, shape, strict=True)]
+    X, Y, Z = np.meshgrid(*axes, indexing="ij")
+    joints = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
+    ids = np.arange(joints.shape[0]).reshape(shape)
+    members = {}
+    for axis, name in enumerate(("beams_x", "beams_y", "columns")):
+        if bays[axis] == 0:
+            continue
+        a = np.delete(ids, -1, axis=axis).ravel()
+        b = np.delete(ids, 0, axis=axis).ravel()
+        members[name] = np.column_stack([a, b])
+    points, cells, cell_sets = _subdivide(joints, members, subdivisions)
+    node_sets = {
+        "base": ids[:, :, 0].ravel(),
+        "top": ids[:, :, -1].ravel(),
+        "joints": ids.ravel(),
+    }
+    return Mesh(points, {"line": cells}, cell_sets, node_sets)
+
+
+def _subdivide(joints, members, k):
+    """Split each member into ``k`` elements with new interior nodes (vectorised)."""
+    points = [joints]
+    cells, cell_sets = [], {}
+    n_points, n_cells = len(joints), 0
+    for name, pairs in members.items():
+        m = len(pairs)
+        t = np.arange(1, k) / k
+        inner = (joints[pairs[:, 0], None, :] * (1 - t)[None, :, None]
+                 + joints[pairs[:, 1], None, :] * t[None, :, None]).reshape(-1, 3)
+        inner_ids = n_points + np.arange(m * (k - 1)).reshape(m, k - 1)
+        chain = np.column_stack([pairs[:, 0], inner_ids, pairs[:, 1]])
+        cells.append(np.stack([chain[:, :-1], chain[:, 1:]], axis=-1).reshape(-1, 2))
+        cell_sets[name] = {"line": n_cells + np.arange(m * k)}
+        points.append(inner)
+        n_points += len(inner)
+        n_cells += m * k
+    return np.concatenate(points), np.concatenate(cells), cell_sets

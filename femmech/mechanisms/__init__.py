@@ -1,0 +1,110 @@
+"""Lumped mechanism models: position functions, M(φ), B(φ), C(φ), F(φ), equations of motion.
+
+The symbols follow the seed chapter (Dresig/Vul'fson, ch. 5): M mass, B damping,
+C stiffness, F force.
+"""
+
+from femmech.mechanisms.chapter import (
+    mobile_crane,
+    mobile_crane_parameters,
+    processing_machine,
+    processing_machine_mixed,
+    processing_machine_parameters,
+    table_5_1_case,
+)
+from femmech.mechanisms.lagrange import (
+    LagrangeTerms,
+    RheolinearTerms,
+    lagrange_terms,
+    rheolinear_terms,
+)
+from femmech.mechanisms.linkages import FourBar, SliderCrank
+from femmech.mechanisms.models import (
+    Accelerations,
+    LagrangeModel,
+    MixedModel,
+    MixedSolution,
+    RheolinearModel,
+    mixed_type,
+    rheolinear,
+    second_kind,
+)
+from femmech.mechanisms.motion_laws import (
+    CamProfile,
+    CamSegment,
+    MotionLaw,
+    PolynomialLaw,
+    SinusoidalLaw,
+    cycloidal,
+    harmonic,
+    modified_sine,
+    modified_trapezoid,
+    polynomial_345,
+)
+from femmech.mechanisms.position import PositionFunction
+from femmech.mechanisms.quasi_modes import (
+    QuasiModes,
+    frozen_eigen,
+    plot_quasi_frequencies,
+    quasi_modes,
+)
+from femmech.mechanisms.symbolic import (
+    Damper,
+    Load,
+    Mechanism,
+    PointMass,
+    Potential,
+    RotaryInertia,
+    Spring,
+    position_function,
+    velocity_symbol,
+)
+from femmech.mechanisms.tabulated import TabulatedPositionFunction
+
+__all__ = [
+    "Accelerations",
+    "CamProfile",
+    "CamSegment",
+    "Damper",
+    "FourBar",
+    "LagrangeModel",
+    "LagrangeTerms",
+    "Load",
+    "Mechanism",
+    "MixedModel",
+    "MixedSolution",
+    "MotionLaw",
+    "PointMass",
+    "PolynomialLaw",
+    "PositionFunction",
+    "Potential",
+    "QuasiModes",
+    "RheolinearModel",
+    "RheolinearTerms",
+    "RotaryInertia",
+    "SinusoidalLaw",
+    "SliderCrank",
+    "Spring",
+    "TabulatedPositionFunction",
+    "cycloidal",
+    "frozen_eigen",
+    "harmonic",
+    "lagrange_terms",
+    "mixed_type",
+    "mobile_crane",
+    "mobile_crane_parameters",
+    "modified_sine",
+    "modified_trapezoid",
+    "polynomial_345",
+    "position_function",
+    "processing_machine",
+    "processing_machine_mixed",
+    "processing_machine_parameters",
+    "plot_quasi_frequencies",
+    "quasi_modes",
+    "rheolinear",
+    "rheolinear_terms",
+    "second_kind",
+    "table_5_1_case",
+    "velocity_symbol",
+]

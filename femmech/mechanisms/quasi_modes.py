@@ -1,0 +1,179 @@
+"""Quasi-eigenfrequencies and quasi-eigenmodes of a mechanism at frozen drive angles.
+
+At each frozen drive angle φ the generalized eigenproblem
+
+    C(φ, Ω, Ω̇) v = ω² M(φ) v
+
+of the rheolinear model (seed 5.2.2 eq. 9; symbols M mass, C stiffness) is solved, and
+the frequencies f = ω/(2π) are followed over a revolution (seed 5.1: "quasi-
+eigenfrequencies"). With Ω = Ω̇ = 0 and position-independent loads, C is the symmetric
+potential part and ``scipy.linalg.eigh`` is used; otherwise C is generally unsymmetric
+(errata item 30) and ``scipy.linalg.eig`` is used. Damping B is ignored (undamped
+quasi-modes).
+"""
+
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import scipy.linalg
+
+__all__ = ["QuasiModes", "frozen_eigen", "plot_quasi_frequencies", "quasi_modes"]
+
+
+@dataclass(frozen=True)
+class QuasiModes:
+    """Quasi-eigenfrequencies over drive angles.
+
+    Attributes
+    ----------
+    phi : ndarray (n_angles,)
+        Drive angles, rad.
+    omega_sq : ndarray (n_angles, n), complex
+        Eigenvalues ω² = λ, 1/s², ascending by real part at each angle.
+    freq_hz : ndarray (n_angles, n)
+        √λ/(2π), Hz, ascending; NaN where λ is not real and positive (possible only for
+        unsymmetric C: divergence or flutter at the frozen angle).
+    modes : ndarray (n_angles, n, n)
+        Column i is the mode of ``freq_hz[:, i]``, normalised to vᵀ M v = 1 with its
+        largest-magnitude entry positive; NaN for complex eigenvalues.
+    symmetric : ndarray (n_angles,), bool
+        True where C was symmetric and ``eigh`` was used.
+    """
+
+    phi: np.ndarray
+    omega_sq: np.ndarray
+    freq_hz: np.ndarray
+    modes: np.ndarray
+    symmetric: np.ndarray
+
+
+def _normalise(v: np.ndarray, M: np.ndarray) -> np.ndarray:
+    """Scale columns to vᵀ M v = 1 and make each column's largest entry positive."""
+    norm = np.sqrt(np.abs(np.einsum("ij,ik,kj->j", v, M, v)))
+    v = v / norm
+    idx = np.argmax(np.abs(v), axis=0)
+    return v * np.sign(v[idx, np.arange(v.shape[1])])
+
+
+def _eigen_one(M: np.ndarray, C: np.ndarray, rtol_symmetry: float, rtol_real: float):
+    scale = np.max(np.abs(C))
+    if np.max(np.abs(C - C.T)) <= rtol_symmetry * scale:
+        lam, v = scipy.linalg.eigh(0.5 * (C + C.T), M)
+        return lam.astype(complex), _normalise(v, M), True
+    lam, v = scipy.linalg.eig(C, M)
+    order = np.lexsort((lam.imag, lam.real))
+    lam, v = lam[order], v[:, order]
+    real = np.abs(lam.imag) <= rtol_real * np.abs(lam)
+    modes = np.full(v.shape, np.nan)
+    if np.any(real):
+        modes[:, real] = _normalise(v[:, real].real, M)
+    return lam, modes, False
+
+
+def frozen_eigen(M: np.ndarray, C: np.ndarray, rtol_symmetry: float = 1e-12,
+                 rtol_real: float = 1e-9) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Solve C v = λ M v for a stack of frozen-angle matrices.
+
+    Parameters
+    ----------
+    M : ndarray (n_angles, n, n)
+        Symmetric positive definite mass matrices.
+    C : ndarray (n_angles, n, n)
+        Stiffness matrices, symmetric or not.
+    rtol_symmetry : float
+        C counts as symmetric if max|C − Cᵀ| <= rtol_symmetry · max|C|.
+    rtol_real : float
+        λ counts as real if |Im λ| <= rtol_real · |λ|.
+
+    Returns
+    -------
+    omega_sq : ndarray (n_angles, n), complex
+        Eigenvalues λ = ω², ascending by real part.
+    modes : ndarray (n_angles, n, n)
+        M-normalised real eigenvectors (columns); NaN for complex λ.
+    symmetric : ndarray (n_angles,), bool
+    """
+    out = [_eigen_one(m, c, rtol_symmetry, rtol_real) for m, c in zip(M, C, strict=True)]
+    return (np.array([o[0] for o in out]), np.array([o[1] for o in out]),
+            np.array([o[2] for o in out]))
+
+
+def quasi_modes(model, phi, Omega=0.0, Omega_dot=0.0) -> QuasiModes:
+    """Quasi-eigenfrequencies of a rheolinear mechanism model at frozen angles.
+
+    Parameters
+    ----------
+    model : RheolinearModel
+        Provides ``M(phi)`` and ``C(phi, Omega, Omega_dot)`` with one drive.
+    phi : array_like (n_angles,)
+        Drive angles, rad.
+    Omega, Omega_dot : float
+        Drive speed (rad/s) and acceleration (rad/s²) entering the kinematic stiffness
+        terms of C (errata item 30); 0 gives the potential (static) part.
+
+    Returns
+    -------
+    QuasiModes
+    """
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    if phi.ndim != 1:
+        raise ValueError(f"phi must be 1-D (one drive), got shape {phi.shape}")
+    lam, modes, sym = frozen_eigen(model.M(phi), model.C(phi, Omega, Omega_dot))
+    ok = (np.abs(lam.imag) <= 1e-9 * np.abs(lam)) & (lam.real > 0)
+    freq = np.where(ok, np.sqrt(np.abs(lam.real)) / (2 * np.pi), np.nan)
+    return QuasiModes(phi, lam, freq, modes, sym)
+
+
+def plot_quasi_frequencies(curves: dict[str, QuasiModes], filename, title: str = "") -> Path:
+    """Plot quasi-eigenfrequencies (Hz) over the drive angle (degrees) into a PNG.
+
+    Parameters
+    ----------
+    curves : dict of str to QuasiModes
+        Label → result; each result's frequencies are drawn with one line style.
+    filename : str or path-like
+        Target PNG; written to a temporary file in the same folder, then renamed.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    Path
+        The written file.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(10, 5), dpi=120)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    styles = ["-", "--", ":", "-."]
+    for i, (label, res) in enumerate(curves.items()):
+        deg = np.rad2deg(res.phi)
+        for k in range(res.freq_hz.shape[1]):
+            ax.plot(deg, res.freq_hz[:, k], styles[i % 4], color=f"C{k}",
+                    label=f"{label}: f{k + 1}")
+    ax.set_xlabel("drive angle φ (°)")
+    ax.set_ylabel("quasi-eigenfrequency (Hz)")
+    ax.set_xlim(0, 360)
+    ax.set_xticks(np.arange(0, 361, 45))
+    ax.set_yscale("log")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
+    if title:
+        ax.set_title(title)
+    fig.tight_layout()
+    target = Path(filename)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".png", dir=target.parent)
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            fig.savefig(handle, format="png")
+        os.replace(tmp, target)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+    return target
