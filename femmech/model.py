@@ -59,6 +59,9 @@ class BeamSet:
     radius : ndarray (n_elements,), m
         Drawing radius (half the largest section dimension).
     group : ndarray (n_elements,) of str
+    phi : ndarray (n_elements, 2)
+        Shear parameters ``Φ = 12 E I / (G A_s L²)`` of the local x-y plane (Iz, Asy) and
+        x-z plane (Iy, Asz); 0 for Euler-Bernoulli bending.
     """
 
     cells: np.ndarray
@@ -66,6 +69,7 @@ class BeamSet:
     length: np.ndarray
     radius: np.ndarray
     group: np.ndarray
+    phi: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -83,6 +87,8 @@ class FEModel:
         Independent DOFs (the columns of T are the unit vectors of these DOFs, plus the
         rigid-link contributions).
     beams : BeamSet
+    mass_nodes : ndarray (n_masses,)
+        Nodes that carry point masses (for drawing).
     """
 
     mesh: Mesh
@@ -91,6 +97,7 @@ class FEModel:
     T: sp.csr_matrix
     free: np.ndarray
     beams: BeamSet
+    mass_nodes: np.ndarray
     K_free: sp.csr_matrix = field(repr=False)
     M_free: sp.csr_matrix = field(repr=False)
 
@@ -144,9 +151,10 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(
     mass_blocks = [(edofs, Me)]
     used = np.zeros(mesh.n_nodes, dtype=bool)
     used[beam_set.cells.ravel()] = True
-    joined = []
+    joined, mass_nodes = [], []
     for item in masses:
         node = node_index(mesh, item.node, "point mass")
+        mass_nodes.append(node)
         mass_blocks.append((node_dofs([node])[None, :], item.matrix()[None]))
         used[node] = True
     for item in springs:
@@ -174,7 +182,8 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(
     K = assemble(stiff_blocks, n_dof)
     M = assemble(mass_blocks, n_dof)
     Tt = T.T.tocsr()
-    return FEModel(mesh, K, M, T, free, beam_set, (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr())
+    return FEModel(mesh, K, M, T, free, beam_set, np.array(mass_nodes, dtype=np.int64),
+                   (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr())
 
 
 def _check_types(beams, masses, springs, supports, rigid_links):
@@ -226,7 +235,9 @@ def _beam_blocks(mesh: Mesh, beams: dict[str, BeamProperty]):
     Ke, Me = beam_matrices(mesh.points, lines, orient, E, G, rho, A, Iy, Iz, J, Ip, Asy, Asz,
                            rotary_inertia=rot)
     group = np.array(names, dtype=object)[owner] if len(lines) else np.empty(0, dtype=object)
-    return BeamSet(lines, R, length, radius, group), Ke, Me, element_dofs(lines)
+    phi = 12.0 * E[:, None] * np.column_stack([Iz, Iy]) / (
+        G[:, None] * np.column_stack([Asy, Asz]) * length[:, None] ** 2)
+    return BeamSet(lines, R, length, radius, group, phi), Ke, Me, element_dofs(lines)
 
 
 def _property_row(p: BeamProperty) -> list[float]:

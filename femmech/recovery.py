@@ -35,10 +35,9 @@ def beam_deflection_curves(model: FEModel, u_full: np.ndarray, n_sub: int = 8,
         (its two end nodes included, so nodes shared by elements appear repeatedly).
     phi : ndarray (n_elements, 2), optional
         Shear parameters ``Φ = 12 E I / (G A_s L²)`` of the local x-y plane (``Iz``,
-        ``Asy``) and the x-z plane (``Iy``, ``Asz``). Default zeros: cubic Hermite
-        (Euler-Bernoulli) interpolation, which is what drawing needs. With the model's Φ
-        the interpolation is the element's own (exact for a static end-loaded Timoshenko
-        element); :class:`femmech.model.FEModel` does not store Φ, so the caller supplies it.
+        ``Asy``) and the x-z plane (``Iy``, ``Asz``). Default: the model's own
+        (``model.beams.phi``), so the interpolation is the element's (exact for a
+        static end-loaded Timoshenko element); zeros give cubic Hermite interpolation.
 
     Returns
     -------
@@ -75,7 +74,7 @@ def beam_deflection_curves(model: FEModel, u_full: np.ndarray, n_sub: int = 8,
         raise ValueError(f"n_sub must be a positive integer, got {n_sub}")
     beams = model.beams
     n_el = len(beams.cells)
-    phi = np.zeros((n_el, 2)) if phi is None else np.asarray(phi, dtype=float)
+    phi = beams.phi if phi is None else np.asarray(phi, dtype=float)
     if phi.shape != (n_el, 2):
         raise ValueError(f"phi must have shape ({n_el}, 2), got {phi.shape}")
     xi = np.linspace(0.0, 1.0, int(n_sub) + 1)

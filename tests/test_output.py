@@ -134,7 +134,9 @@ def test_curves_with_shear_parameter_reproduce_timoshenko_field():
     s = points[:, 0]
     expected = P * s**2 * (3 * length - s) / (6 * STEEL.E * sec.Iz) + P * s / (G * sec.Asy)
     assert_allclose(disp[:, 1], expected, rtol=0, atol=1e-10 * expected.max())  # round-off
-    hermite = beam_deflection_curves(model, u, n_sub=10)[1][:, 1]
+    default = beam_deflection_curves(model, u, n_sub=10)[1]  # the model's own Φ
+    assert_allclose(default, disp, rtol=0, atol=1e-12 * np.abs(disp).max())
+    hermite = beam_deflection_curves(model, u, n_sub=10, phi=np.zeros((1, 2)))[1][:, 1]
     assert np.abs(hermite - expected).max() > 1e-3 * expected.max()  # Φ matters here
 
 

@@ -155,7 +155,7 @@ def _select_headless_backend() -> None:
 
 def plot_mode(model: FEModel, modes: ModeSet, index: int, filename, scale: float | None = None,
               window_size=(1024, 768), camera=None, n_sub: int = 8,
-              show_undeformed: bool = True, masses=()) -> Path:
+              show_undeformed: bool = True, masses=None) -> Path:
     """Render one mode shape off-screen to a PNG file.
 
     Parameters
@@ -178,9 +178,9 @@ def plot_mode(model: FEModel, modes: ModeSet, index: int, filename, scale: float
         Sub-intervals per element of the drawn curves.
     show_undeformed : bool
         Draw a thin grey ghost of the undeformed beams.
-    masses : sequence of PointMass
-        Point masses to draw as spheres at their displaced nodes (the model does not
-        keep its lumped items, so pass the ones given to :func:`femmech.build_model`).
+    masses : sequence of PointMass, optional
+        Point masses to draw as spheres at their displaced nodes; default: all point
+        masses of the model (``model.mass_nodes``).
 
     Returns
     -------
@@ -199,8 +199,11 @@ def plot_mode(model: FEModel, modes: ModeSet, index: int, filename, scale: float
     index = int(_mode_indices(modes, [index])[0])
     u = modes.shapes[:, index]
     scale = mode_scale(model, u, n_sub) if scale is None else float(scale)
-    mass_nodes = np.array([node_index(model.mesh, m.node, "point mass") for m in masses],
-                          dtype=np.int64)
+    if masses is None:
+        mass_nodes = model.mass_nodes
+    else:
+        mass_nodes = np.array([node_index(model.mesh, m.node, "point mass") for m in masses],
+                              dtype=np.int64)
     width, height = (int(v) for v in window_size)
     _select_headless_backend()
     import pyvista as pv
