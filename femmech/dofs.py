@@ -54,7 +54,8 @@ def node_dofs(nodes, comps=None) -> np.ndarray:
 def element_dofs(cells: np.ndarray) -> np.ndarray:
     """DOF indices of each element, shape (n_elements, 6 * nodes_per_element)."""
     cells = np.asarray(cells, dtype=np.int64)
-    return (DOF_PER_NODE * cells[:, :, None] + np.arange(DOF_PER_NODE)).reshape(len(cells), -1)
+    n_ldof = DOF_PER_NODE * cells.shape[1]  # explicit, so that zero elements also work
+    return (DOF_PER_NODE * cells[:, :, None] + np.arange(DOF_PER_NODE)).reshape(len(cells), n_ldof)
 
 
 def dof_label(dof: int) -> str:

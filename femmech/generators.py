@@ -30,6 +30,9 @@ def grid_frame(bays=(2, 2, 2), size=(1.0, 1.0, 1.0), subdivisions: int = 1) -> M
     bays = tuple(int(b) for b in bays)
     if len(bays) != 3 or min(bays) < 0 or sum(b > 0 for b in bays) == 0:
         raise ValueError(f"bays must be three non-negative integers, not all zero, got {bays}")
+    size = tuple(float(s) for s in size)
+    if len(size) != 3 or not all(np.isfinite(s) and s > 0 for s in size):
+        raise ValueError(f"size must be three positive lengths, got {size}")
     if subdivisions < 1:
         raise ValueError(f"subdivisions must be >= 1, got {subdivisions}")
     shape = tuple(b + 1 for b in bays)

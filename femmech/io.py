@@ -14,6 +14,11 @@ def from_meshio(mesh) -> Mesh:
     physical groups) become :attr:`Mesh.cell_sets`, and sets made of vertex cells
     (Gmsh physical points) become :attr:`Mesh.node_sets`. Sets named ``gmsh:*`` are
     ignored.
+
+    Readers that return groups as integer cell data instead of cell sets are decoded
+    too: Gmsh 2.2 files (``gmsh:physical`` tags named by ``field_data``) and files such
+    as VTU to which meshio wrote cell sets as one integer array named ``"a-b-c"`` (value
+    ``k`` = set ``k``, -1 = none; see ``meshio.Mesh.cell_sets_to_data``).
     """
     offsets, cells = [], {}
     for block in mesh.cells:
@@ -24,9 +29,8 @@ def from_meshio(mesh) -> Mesh:
         cells[block.type].append(np.asarray(block.data))
     merged = {kind: np.concatenate(parts) for kind, parts in cells.items()}
     cell_sets, node_sets = {}, {}
-    for name, per_block in mesh.cell_sets.items():
-        if name.startswith("gmsh:"):
-            continue
+    raw_sets = {k: v for k, v in mesh.cell_sets.items() if not k.startswith("gmsh:")}
+    for name, per_block in (raw_sets or _sets_from_cell_data(mesh)).items():
         by_type = {}
         for block, offset, idx in zip(mesh.cells, offsets, per_block, strict=True):
             if idx is None or len(idx) == 0:
@@ -40,6 +44,36 @@ def from_meshio(mesh) -> Mesh:
             cell_sets[name] = by_type
     merged.pop("vertex", None)
     return Mesh(mesh.points, merged, cell_sets, node_sets)
+
+
+def _sets_from_cell_data(mesh) -> dict:
+    """Cell sets (name → index array per block) from integer cell data, see from_meshio."""
+    data = mesh.cell_data
+    if "gmsh:physical" in data:
+        names = {(int(v[0]), int(v[1])): k for k, v in mesh.field_data.items() if len(v) == 2}
+        out = {}
+        for k, (block, tags) in enumerate(zip(mesh.cells, data["gmsh:physical"], strict=True)):
+            tags = np.asarray(tags)
+            for tag in np.unique(tags[tags > 0]):
+                name = names.get((int(tag), _CELL_DIM.get(block.type, -1)), str(tag))
+                out.setdefault(name, [None] * len(mesh.cells))[k] = np.flatnonzero(tags == tag)
+        return out
+    out = {}
+    for key, arrays in data.items():
+        names = key.split("-")
+        values = [np.asarray(a) for a in arrays]
+        if (key.startswith("gmsh:") or len(set(names)) != len(names)
+                or not all(v.dtype.kind in "iu" and v.ndim == 1 for v in values)
+                or any(v.size and (v.min() < -1 or v.max() >= len(names)) for v in values)):
+            continue
+        for i, name in enumerate(names):
+            out[name] = [np.flatnonzero(v == i) for v in values]
+    return out
+
+
+_CELL_DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "quad": 2, "triangle6": 2,
+             "quad8": 2, "quad9": 2, "tetra": 3, "tetra10": 3, "hexahedron": 3,
+             "hexahedron20": 3, "hexahedron27": 3, "wedge": 3}
 
 
 def read_mesh(path) -> Mesh:

@@ -124,6 +124,7 @@ def _check_cells(kind: str, cells, n_nodes: int) -> np.ndarray:
     bad = np.flatnonzero((cells < 0).any(axis=1) | (cells >= n_nodes).any(axis=1))
     if bad.size:
         e = bad[0]
-        raise ValueError(f"{kind} cell {e} references node {cells[e].tolist()},"
+        node = cells[e][(cells[e] < 0) | (cells[e] >= n_nodes)][0]
+        raise ValueError(f"{kind} cell {e} (nodes {cells[e].tolist()}) references node {node},"
                          f" but the mesh has {n_nodes} nodes")
     return cells

@@ -7,6 +7,7 @@ system is ``Tᵀ K T``, ``Tᵀ M T``.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -89,6 +90,9 @@ class FEModel:
     beams : BeamSet
     mass_nodes : ndarray (n_masses,)
         Nodes that carry point masses (for drawing).
+    links : ndarray (n_links, 2)
+        Node pairs joined by rigid links (master, slave) or node-to-node springs, for
+        drawing.
     """
 
     mesh: Mesh
@@ -98,6 +102,7 @@ class FEModel:
     free: np.ndarray
     beams: BeamSet
     mass_nodes: np.ndarray
+    links: np.ndarray
     K_free: sp.csr_matrix = field(repr=False)
     M_free: sp.csr_matrix = field(repr=False)
 
@@ -182,11 +187,15 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(
     K = assemble(stiff_blocks, n_dof)
     M = assemble(mass_blocks, n_dof)
     Tt = T.T.tocsr()
-    return FEModel(mesh, K, M, T, free, beam_set, np.array(mass_nodes, dtype=np.int64),
+    links = np.array(joined, dtype=np.int64).reshape(-1, 2)
+    return FEModel(mesh, K, M, T, free, beam_set, np.array(mass_nodes, dtype=np.int64), links,
                    (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr())
 
 
 def _check_types(beams, masses, springs, supports, rigid_links):
+    if not isinstance(beams, Mapping):
+        raise TypeError(f"beams must be a dict {{cell-set name: BeamProperty}},"
+                        f" got {type(beams).__name__}")
     for label, items, kind in (("masses", masses, PointMass), ("springs", springs, Spring),
                                ("supports", supports, Support),
                                ("rigid_links", rigid_links, RigidLink)):
@@ -280,6 +289,8 @@ def node_indices(mesh: Mesh, ref, what: str) -> np.ndarray:
         except ValueError as exc:
             raise ValueError(f"{what}: {exc}") from None
     nodes = np.atleast_1d(np.asarray(ref))
+    if nodes.size == 0:  # an empty list is float by default
+        return np.empty(0, dtype=np.int64)
     if not np.issubdtype(nodes.dtype, np.integer):
         raise TypeError(f"{what}: nodes must be a group name or node indices, got {ref!r}")
     bad = nodes[(nodes < 0) | (nodes >= mesh.n_nodes)]

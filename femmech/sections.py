@@ -100,6 +100,11 @@ def _positive(name: str, **values: float) -> None:
             raise ValueError(f"{name}: {key} must be positive and finite, got {value}")
 
 
+def _poisson(name: str, nu: float) -> None:
+    if not -1.0 < nu < 0.5:
+        raise ValueError(f"{name}: nu must lie in (-1, 0.5), got {nu}")
+
+
 def rectangle_torsion_constant(a: float, b: float, terms: int = 50) -> float:
     """Saint-Venant torsion constant of a solid a x b rectangle, m^4.
 
@@ -120,6 +125,7 @@ def rectangle(width: float, height: float, nu: float = 0.3, name: str = "rectang
     (0.850 for ν = 0.3).
     """
     _positive(name, width=width, height=height)
+    _poisson(name, nu)
     A = width * height
     k = 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu)
     return BeamSection(
@@ -136,6 +142,7 @@ def tube(outer_diameter: float, inner_diameter: float, nu: float = 0.3, name: st
     ``k = 6(1+ν)(1+m²)² / ((7+6ν)(1+m²)² + (20+12ν)m²)``, ``m = d_i / d_o``.
     """
     _positive(name, outer_diameter=outer_diameter)
+    _poisson(name, nu)
     if not 0.0 <= inner_diameter < outer_diameter:
         raise ValueError(
             f"{name}: inner_diameter must lie in [0, outer_diameter), got {inner_diameter}"
@@ -153,6 +160,7 @@ def tube(outer_diameter: float, inner_diameter: float, nu: float = 0.3, name: st
 
 def circle(diameter: float, nu: float = 0.3, name: str = "circle"):
     """Solid circle of ``diameter`` (m); see :func:`tube` for the shear coefficient."""
+    _positive(name, diameter=diameter)
     return tube(diameter, 0.0, nu=nu, name=name)
 
 

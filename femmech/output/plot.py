@@ -42,6 +42,7 @@ _CMAP = "viridis"
 _GHOST_COLOR = "#9a9a9a"
 _FIXTURE_COLOR = "#3c3c3c"
 _MASS_COLOR = "#b2182b"
+_LINK_COLOR = "#d08c2c"  # rigid links and node-to-node springs
 
 
 def model_size(model: FEModel) -> float:
@@ -303,6 +304,11 @@ def _add_scene(plotter, model, u, scale, n_sub, show_undeformed, mass_nodes,
                                     capping=False),
                          color=_GHOST_COLOR, opacity=0.35, smooth_shading=True)
     _add_markers(plotter, model, joints.points, mass_nodes, node_r)
+    if len(model.links):
+        segments = pv.PolyData(joints.points, lines=np.column_stack(
+            [np.full(len(model.links), 2), model.links]).ravel())
+        plotter.add_mesh(segments.tube(radius=0.4 * float(node_r.max()), n_sides=12),
+                         color=_LINK_COLOR, smooth_shading=True)
 
 
 def _add_markers(plotter, model, displaced, mass_nodes, node_r) -> None:
