@@ -91,6 +91,9 @@ def read_mesh(path) -> Mesh:
         raw = meshio.read(path)
     except Exception as exc:  # meshio raises many types; report them uniformly
         raise ValueError(f"{path}: meshio could not read the file ({exc})") from exc
+    except SystemExit as exc:  # meshio 5.3 calls sys.exit(1) when no reader succeeds
+        raise ValueError(f"{path}: meshio could not read the file (no reader for its"
+                         " extension accepted the contents)") from exc
     try:
         return from_meshio(raw)
     except ValueError as exc:

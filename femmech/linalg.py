@@ -18,6 +18,9 @@ import scipy.sparse.linalg as spla
 
 from femmech.errors import FemmechWarning
 
+MAX_DEFLATIONS = 10
+"""Deflated ARPACK restarts allowed to complete a set that the Sturm count shows short."""
+
 DENSE_BELOW = 400
 """Systems with fewer DOFs than this are solved with dense LAPACK (``scipy.linalg.eigh``)."""
 
@@ -158,14 +161,36 @@ def _dense(K, M, sigma):
     return omega2[order], X[:, finite][:, order]
 
 
-def _arpack(K, M, k, sigma, lu):
+def _arpack(K, M, k, sigma, lu, deflate=None):
+    """``k`` eigenpairs nearest ``sigma`` by shift-invert Lanczos (ARPACK).
+
+    ``deflate`` (n, m), M-orthonormal eigenvectors already found, is projected out of the
+    start vector and of every operator application (``P (K - σM)⁻¹`` with
+    ``P = I - X Xᵀ M``), so the run finds further members of a repeated eigenvalue that a
+    single Krylov sequence cannot see.
+    """
     n = K.shape[0]
     v0 = np.random.default_rng(12345).standard_normal(n)
-    op = spla.LinearOperator((n, n), matvec=lu.solve, dtype=float)
+    solve = lu.solve
+    if deflate is not None and deflate.shape[1]:
+        MX = M @ deflate
+
+        def solve(v):
+            y = lu.solve(v)
+            return y - deflate @ (MX.T @ y)
+
+        v0 = v0 - deflate @ (MX.T @ v0)
+    op = spla.LinearOperator((n, n), matvec=solve, dtype=float)
     omega2, X = spla.eigsh(sp.csr_matrix(K), k=k, M=sp.csr_matrix(M), sigma=sigma,
                            which="LM", OPinv=op, v0=v0)
     order = np.argsort(omega2)
     return omega2[order], X[:, order]
+
+
+def _merge(omega2, X, more_omega2, more_X):
+    omega2 = np.concatenate([omega2, more_omega2])
+    order = np.argsort(omega2)
+    return omega2[order], np.hstack([X, more_X])[:, order]
 
 
 def default_shift(K, M) -> float:
@@ -175,7 +200,7 @@ def default_shift(K, M) -> float:
 
 def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] | None = None,
                     sigma: float | None = None, dense_below: int = DENSE_BELOW,
-                    check: bool = True) -> EigenResult:
+                    check: bool = True, factor=None) -> EigenResult:
     """Lowest eigenpairs, or all eigenpairs in a band, of ``K x = λ M x``.
 
     Parameters
@@ -193,7 +218,11 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         Use dense LAPACK below this size.
     check : bool
         Verify by a Sturm-sequence count that no eigenvalue was missed (one extra
-        factorisation); raises RuntimeError if one was.
+        factorisation); members of a repeated eigenvalue that ARPACK missed are then
+        found by deflated restarts. Band searches always count.
+    factor : object with ``solve``, optional
+        A factorisation of ``K - sigma M`` to reuse (``sigma`` must then be given), e.g.
+        the ``K_ii`` factorisation of a Craig-Bampton reduction with ``sigma = 0``.
 
     Returns
     -------
@@ -206,6 +235,8 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         raise ValueError(f"n_modes must lie in 1..{n} (the number of free DOFs), got {n_modes}")
     if band is not None and not band[0] < band[1]:
         raise ValueError(f"band must be (low, high) with low < high, got {band}")
+    if factor is not None and sigma is None:
+        raise ValueError("a reused factorisation needs the shift sigma it was made with")
     shift = default_shift(K, M) if sigma is None else float(sigma)
     if n < dense_below:
         omega2, X = _dense(K, M, shift)
@@ -213,25 +244,18 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         omega2, X = result
         method = "dense"
     elif n_modes is not None:
-        omega2, X = _sparse_lowest(K, M, n_modes, shift)
+        omega2, X, count, cut = _sparse_lowest(K, M, n_modes, shift, factor, check)
         method = "arpack"
     else:
-        omega2, X, shift = _sparse_band(K, M, band, sigma)
+        omega2, X, shift = _sparse_band(K, M, band, sigma, factor)
         method = "arpack"
     X = normalize_modes(X, M)
     res = residuals(K, M, omega2, X, abs(default_shift(K, M)))
     if res.size and res.max() > 1e-6:
         warnings.warn(f"eigen solve: largest relative residual {res.max():.2e} exceeds 1e-6",
                       FemmechWarning, stacklevel=2)
-    count, cut = (None, None)
-    if check and method == "arpack" and n_modes is not None and omega2.size:
-        cut = _cut_above(omega2[-1], K, M)
-        count = inertia_below(K, M, cut)
-        if count is not None and count != omega2.size:
-            raise RuntimeError(
-                f"Sturm check: {count} eigenvalues lie below {cut:.6g} rad²/s² but the solver"
-                f" returned {omega2.size}; retry with a larger n_modes or another sigma"
-            )
+    if method == "dense" or n_modes is None:
+        count, cut = None, None
     return EigenResult(omega2, X, method, shift, res, count, cut)
 
 
@@ -247,23 +271,47 @@ def _select(omega2, X, n_modes, band):
     return omega2[:count], X[:, :count]
 
 
-def _sparse_lowest(K, M, n_modes, sigma):
+def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True):
+    """Lowest ``n_modes`` eigenpairs (plus the rest of a cut cluster), Sturm-checked.
+
+    Returns ``omega2, X, sturm_count, cut``. Where the Sturm count shows that a repeated
+    eigenvalue has more members than ARPACK found, deflated runs add the missing ones.
+    """
     n = K.shape[0]
-    lu = factorize(K - sigma * M)
-    guard = min(max(4, n_modes // 5), n - 1 - n_modes)
-    k = n_modes + max(guard, 0)
-    if k >= n - 1:
-        raise ValueError(f"{n_modes} modes of a {n}-DOF system: use the dense path"
-                         " (raise dense_below) or ask for fewer modes")
-    omega2, X = _arpack(K, M, k, sigma, lu)
-    count = _complete_cluster(omega2, n_modes)
-    if count == k:
-        raise RuntimeError("a cluster of repeated eigenvalues fills all computed modes;"
-                           " ask for more modes")
-    return omega2[:count], X[:, :count]
+    lu = factorize(K - sigma * M) if factor is None else factor
+    guard = max(4, n_modes // 5)
+    while True:
+        k = min(n_modes + guard, n - 2)
+        if k < n_modes:
+            raise ValueError(f"{n_modes} modes of a {n}-DOF system: use the dense path"
+                             " (raise dense_below) or ask for fewer modes")
+        omega2, X = _arpack(K, M, k, sigma, lu)
+        count = _complete_cluster(omega2, n_modes)
+        if count < k or k == n - 2:
+            break
+        guard *= 2  # a cluster of repeated eigenvalues fills all computed modes
+    omega2, X = omega2[:count], X[:, :count]
+    if not check:
+        return omega2, X, None, None
+    for _ in range(MAX_DEFLATIONS):
+        cut = _cut_above(omega2[-1], K, M)
+        below = inertia_below(K, M, cut)
+        if below is None or below == omega2.size:
+            return omega2, X, below, cut
+        if below < omega2.size:
+            raise RuntimeError(f"Sturm check: {below} eigenvalues lie below {cut:.6g} rad²/s²"
+                               f" but the solver returned {omega2.size}")
+        extra = min(below - omega2.size + guard, n - 2 - omega2.size)
+        omega2, X = _merge(omega2, X, *_arpack(K, M, extra, sigma, lu, deflate=X))
+        omega2, X = omega2[omega2 <= cut], X[:, omega2 <= cut]
+        count = _complete_cluster(omega2, min(n_modes, omega2.size))
+        omega2, X = omega2[:count], X[:, :count]
+    raise RuntimeError(f"Sturm check: eigenvalues below {cut:.6g} rad²/s² still missing after"
+                       f" {MAX_DEFLATIONS} deflated restarts; try another sigma")
 
 
-def _sparse_band(K, M, band, sigma):
+def _sparse_band(K, M, band, sigma, factor=None):
+    """All eigenpairs in ``band``: Sturm counts fix how many, deflation finds them all."""
     lo, hi = band
     n = K.shape[0]
     below_hi = inertia_below(K, M, hi)
@@ -277,10 +325,16 @@ def _sparse_band(K, M, band, sigma):
         return np.empty(0), np.empty((n, 0)), shift
     if count + 2 >= n - 1:
         raise ValueError(f"the band holds {count} of {n} eigenvalues: use the dense path")
-    lu = factorize(K - shift * M, pivot_threshold=0.01)
-    omega2, X = _arpack(K, M, min(count + 2, n - 2), shift, lu)
-    keep = (omega2 >= lo) & (omega2 <= hi)
-    if keep.sum() != count:
-        raise RuntimeError(f"band search found {keep.sum()} of {count} eigenvalues"
+    lu = factorize(K - shift * M, pivot_threshold=0.01) if factor is None else factor
+    omega2, X = np.empty(0), np.empty((n, 0))
+    for _ in range(MAX_DEFLATIONS):
+        k = min(count - omega2.size + 2, n - 2 - omega2.size)
+        omega2, X = _merge(omega2, X, *_arpack(K, M, k, shift, lu, deflate=X))
+        keep = (omega2 >= lo) & (omega2 <= hi)
+        omega2, X = omega2[keep], X[:, keep]
+        if omega2.size >= count:
+            break
+    if omega2.size != count:
+        raise RuntimeError(f"band search found {omega2.size} of {count} eigenvalues"
                            f" (Sturm count) in [{lo:.6g}, {hi:.6g}] rad²/s²")
-    return omega2[keep], X[:, keep], shift
+    return omega2, X, shift

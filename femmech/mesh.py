@@ -128,3 +128,42 @@ def _check_cells(kind: str, cells, n_nodes: int) -> np.ndarray:
         raise ValueError(f"{kind} cell {e} (nodes {cells[e].tolist()}) references node {node},"
                          f" but the mesh has {n_nodes} nodes")
     return cells
+
+
+def line_submesh(mesh: Mesh, elements) -> tuple[Mesh, np.ndarray]:
+    """Mesh of a subset of the line elements, with nodes renumbered.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    elements : array_like of int or bool (n_lines,)
+        Line elements to keep (indices or a mask).
+
+    Returns
+    -------
+    sub : Mesh
+        Only the used nodes; cell sets and node sets restricted to what is kept (empty
+        ones dropped).
+    node_ids : ndarray (sub.n_nodes,)
+        Original index of each node of ``sub``.
+    """
+    lines = mesh.cells.get("line", np.empty((0, 2), dtype=np.int64))
+    keep = np.zeros(len(lines), dtype=bool)
+    keep[np.asarray(elements)] = True
+    node_ids = np.unique(lines[keep])
+    new_node = np.full(mesh.n_nodes, -1)
+    new_node[node_ids] = np.arange(node_ids.size)
+    new_cell = np.full(len(lines), -1)
+    new_cell[keep] = np.arange(keep.sum())
+    cell_sets = {}
+    for name, by_type in mesh.cell_sets.items():
+        idx = new_cell[by_type.get("line", np.empty(0, dtype=np.int64))]
+        if (idx >= 0).any():
+            cell_sets[name] = {"line": idx[idx >= 0]}
+    node_sets = {}
+    for name, nodes in mesh.node_sets.items():
+        sub = new_node[nodes]
+        if (sub >= 0).any():
+            node_sets[name] = sub[sub >= 0]
+    sub = Mesh(mesh.points[node_ids], {"line": new_node[lines[keep]]}, cell_sets, node_sets)
+    return sub, node_ids

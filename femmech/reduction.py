@@ -1,0 +1,366 @@
+"""Substructure reduction: Guyan and Craig-Bampton superelements with recovery.
+
+The free DOFs of an :class:`~femmech.model.FEModel` (after supports and rigid links)
+are split into interface DOFs ``b`` (kept physically: bearings, mounts, joints to other
+substructures) and interior DOFs ``i``. With ``K_ii`` factorised once,
+
+* constraint modes ``Ψ = -K_ii⁻¹ K_ib`` (static response to unit interface motions),
+* fixed-interface normal modes ``K_ii Φ = M_ii Φ Λ`` (shift-invert at σ = 0, reusing the
+  same factorisation), mass-normalised,
+
+give the Craig-Bampton basis ``u = [[I, 0], [Ψ, Φ]] [u_b; η]`` (R. R. Craig and
+M. C. C. Bampton, "Coupling of substructures for dynamic analyses", AIAA J. 6 (1968)
+1313-1319); Guyan's static condensation (R. J. Guyan, AIAA J. 3 (1965) 380) is the case
+without Φ. The reduced matrices are ``Tᵀ K T`` and ``Tᵀ M T``; ``K_r`` is block diagonal
+``diag(K_bb + K_bi Ψ, Λ)``. Only the tall dense bases (n_i × n_b, n_i × n_q) are formed,
+never a dense matrix of full-model size.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+
+from femmech.dofs import DOF_PER_NODE, components, dof_label
+from femmech.linalg import factorize, solve_symmetric
+from femmech.model import FEModel, node_indices
+
+CUTOFF_FACTOR = 2.0
+"""Default cutoff of fixed-interface modes as a multiple of the highest frequency of
+interest (``f_max_hz``): with modes up to 2 f_max, Craig-Bampton frequencies below f_max
+are typically accurate to well below 0.1 % (see benchmarks/reduction.py)."""
+
+FORMAT_VERSION = 1
+
+
+@dataclass(frozen=True)
+class Superelement:
+    """Reduced model of a substructure, with recovery of the full field.
+
+    Symbols: K stiffness, M mass (reduced, dense, symmetric). Reduced coordinates are
+    the ``n_b`` physical interface DOFs (m, rad) followed by ``n_q`` modal amplitudes
+    of the fixed-interface modes (kg^½ m, mass-normalised modes).
+
+    Attributes
+    ----------
+    K, M : ndarray (n_r, n_r)
+    method : str
+        ``"guyan"`` or ``"craig-bampton"``.
+    interface_dofs : ndarray (n_b,)
+        Full-model DOF index of each interface coordinate (``6 * node + component``).
+    interface_points : ndarray (n_b, 3)
+        Coordinates (m) of the node of each interface DOF.
+    modal_omega2 : ndarray (n_q,)
+        Fixed-interface eigenvalues, rad²/s².
+    Psi : ndarray (n_i, n_b)
+        Constraint modes on the interior free DOFs.
+    Phi : ndarray (n_i, n_q)
+        Fixed-interface modes on the interior free DOFs.
+    free_interface, free_interior : ndarray
+        Positions of interface and interior DOFs among the model's free DOFs.
+    T : scipy.sparse.csr_matrix (n_dof, n_free)
+        The model's constraint transformation, for expansion to all DOFs.
+    timings : dict[str, float]
+        Seconds spent in ``factorisation``, ``constraint_modes``, ``fixed_interface_modes``
+        and ``projection``.
+    """
+
+    K: np.ndarray
+    M: np.ndarray
+    method: str
+    interface_dofs: np.ndarray
+    interface_points: np.ndarray
+    modal_omega2: np.ndarray
+    Psi: np.ndarray
+    Phi: np.ndarray
+    free_interface: np.ndarray
+    free_interior: np.ndarray
+    T: sp.csr_matrix
+    timings: dict = field(default_factory=dict)
+    interior_factor: object = field(default=None, compare=False, repr=False)
+
+    @property
+    def n_interface(self) -> int:
+        """Number of physical interface DOFs n_b."""
+        return len(self.interface_dofs)
+
+    @property
+    def n_modal(self) -> int:
+        """Number of fixed-interface modes n_q."""
+        return len(self.modal_omega2)
+
+    @property
+    def n_reduced(self) -> int:
+        """Number of reduced coordinates n_b + n_q."""
+        return self.K.shape[0]
+
+    @property
+    def n_dof(self) -> int:
+        """Number of full-model DOFs."""
+        return self.T.shape[0]
+
+    @property
+    def kinds(self) -> np.ndarray:
+        """``"interface"`` or ``"modal"`` for each reduced coordinate, shape (n_r,)."""
+        return np.array(["interface"] * self.n_interface + ["modal"] * self.n_modal)
+
+    @property
+    def modal_freq_hz(self) -> np.ndarray:
+        """Fixed-interface natural frequencies, Hz."""
+        return np.sqrt(np.clip(self.modal_omega2, 0.0, None)) / (2 * np.pi)
+
+    def interface_labels(self) -> list[str]:
+        """Readable labels such as ``"node 12 uz"`` for the interface coordinates."""
+        return [dof_label(int(d)) for d in self.interface_dofs]
+
+    def expand_free(self, q: np.ndarray) -> np.ndarray:
+        """Free-DOF vector(s) (n_free, ...) from reduced coordinates q (n_r, ...)."""
+        q = np.asarray(q, dtype=float)
+        if q.shape[0] != self.n_reduced:
+            raise ValueError(f"reduced vector has {q.shape[0]} rows, the superelement"
+                             f" has {self.n_reduced} coordinates")
+        qb, qm = q[:self.n_interface], q[self.n_interface:]
+        u = np.zeros((self.T.shape[1],) + q.shape[1:])
+        u[self.free_interface] = qb
+        u[self.free_interior] = np.tensordot(self.Psi, qb, 1) + np.tensordot(self.Phi, qm, 1)
+        return u
+
+    def recover(self, q: np.ndarray) -> np.ndarray:
+        """Full-model DOF vector(s) (n_dof, ...) from reduced coordinates q (n_r, ...).
+
+        Works for a static solution, a mode shape or a time history (columns).
+        """
+        u = self.expand_free(q)
+        return (self.T @ u.reshape(u.shape[0], -1)).reshape((self.n_dof,) + u.shape[1:])
+
+    def save(self, path) -> Path:
+        """Write to one ``.npz`` file (atomically); read back with :meth:`load`."""
+        path = Path(path)
+        T = self.T.tocsr()
+        arrays = {name: getattr(self, name) for name in _ARRAYS}
+        meta = {"format_version": FORMAT_VERSION, "method": self.method,
+                "timings": self.timings, "n_dof": self.n_dof}
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".npz")
+        try:
+            with os.fdopen(fd, "wb") as stream:
+                np.savez_compressed(stream, T_data=T.data, T_indices=T.indices,
+                                    T_indptr=T.indptr, T_shape=np.array(T.shape),
+                                    meta=np.array(json.dumps(meta)), **arrays)
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        return path
+
+    @classmethod
+    def load(cls, path) -> Superelement:
+        """Read a superelement written by :meth:`save`."""
+        with np.load(Path(path), allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+            if meta.get("format_version") != FORMAT_VERSION:
+                raise ValueError(f"{path}: superelement format {meta.get('format_version')},"
+                                 f" expected {FORMAT_VERSION}")
+            T = sp.csr_matrix((data["T_data"], data["T_indices"], data["T_indptr"]),
+                              shape=tuple(data["T_shape"]))
+            arrays = {name: data[name] for name in _ARRAYS}
+        return cls(method=meta["method"], T=T, timings=meta["timings"], **arrays)
+
+
+_ARRAYS = ("K", "M", "interface_dofs", "interface_points", "modal_omega2", "Psi", "Phi",
+           "free_interface", "free_interior")
+
+
+def interface_dofs(model: FEModel, interface) -> np.ndarray:
+    """Full-model DOF indices of an interface specification.
+
+    Parameters
+    ----------
+    model : FEModel
+    interface : str, int, or sequence of (str | int | (nodes, components))
+        Group names or node indices (all six DOFs of each node), or pairs of a group/
+        node(s) and components (``("guide", ["uy", "uz"])``).
+
+    Returns
+    -------
+    ndarray of int, sorted, unique.
+
+    Raises
+    ------
+    ValueError
+        Naming the DOF if it is supported or the slave of a rigid link (not a free DOF).
+    """
+    items = [interface] if isinstance(interface, (str, int, np.integer)) else list(interface)
+    if not items:
+        raise ValueError("the interface is empty: give node sets, nodes or (nodes, dofs)")
+    dofs = []
+    for item in items:
+        if isinstance(item, tuple) and len(item) == 2:
+            nodes, comps = node_indices(model.mesh, item[0], "interface"), components(item[1])
+        else:
+            nodes, comps = node_indices(model.mesh, item, "interface"), np.arange(DOF_PER_NODE)
+        dofs.append((DOF_PER_NODE * nodes[:, None] + comps).ravel())
+    dofs = np.unique(np.concatenate(dofs))
+    position = np.searchsorted(model.free, dofs)
+    position = np.minimum(position, model.free.size - 1)
+    bad = dofs[model.free[position] != dofs]
+    if bad.size:
+        raise ValueError(f"interface DOF {dof_label(int(bad[0]))} is not a free DOF (it is"
+                         " supported or the slave of a rigid link); use the master node or"
+                         " drop the support")
+    return dofs
+
+
+def guyan(model: FEModel, interface) -> Superelement:
+    """Guyan (static) condensation onto the interface DOFs.
+
+    Reproduces the full model's static response to any load on the interface DOFs
+    exactly (to round-off); the mass is condensed with the static shapes.
+    """
+    return _reduce(model, interface, None, method="guyan")
+
+
+def craig_bampton(model: FEModel, interface, n_modes: int | None = None,
+                  cutoff_hz: float | None = None, f_max_hz: float | None = None) -> Superelement:
+    """Craig-Bampton reduction: interface DOFs + fixed-interface normal modes.
+
+    Parameters
+    ----------
+    model : FEModel
+    interface : see :func:`interface_dofs`
+    n_modes : int, optional
+        Number of fixed-interface modes.
+    cutoff_hz : float, optional
+        Keep all fixed-interface modes below this frequency, Hz.
+    f_max_hz : float, optional
+        Highest frequency of interest, Hz; keeps modes below ``CUTOFF_FACTOR * f_max_hz``.
+
+    Give exactly one of ``n_modes``, ``cutoff_hz`` and ``f_max_hz``.
+
+    Returns
+    -------
+    Superelement
+        Reduced frequencies are upper bounds of the full ones (Rayleigh-Ritz) and
+        converge as modes are added.
+    """
+    given = [v is not None for v in (n_modes, cutoff_hz, f_max_hz)]
+    if sum(given) != 1:
+        raise ValueError("give exactly one of n_modes, cutoff_hz and f_max_hz")
+    if f_max_hz is not None:
+        cutoff_hz = CUTOFF_FACTOR * float(f_max_hz)
+    if cutoff_hz is not None and not cutoff_hz > 0:
+        raise ValueError(f"cutoff_hz must be positive, got {cutoff_hz}")
+    if n_modes is not None and n_modes < 0:
+        raise ValueError(f"n_modes must be >= 0, got {n_modes}")
+    selection = ("count", int(n_modes)) if n_modes is not None else ("cutoff", cutoff_hz)
+    return _reduce(model, interface, selection, method="craig-bampton")
+
+
+def _reduce(model: FEModel, interface, selection, method: str) -> Superelement:
+    dofs = interface_dofs(model, interface)
+    b = np.searchsorted(model.free, dofs)
+    interior = np.setdiff1d(np.arange(model.n_free), b)
+    if interior.size == 0:
+        raise ValueError("every free DOF is an interface DOF: nothing to reduce")
+    K, M = model.K_free.tocsr(), model.M_free.tocsr()
+    Kii, Kib = K[interior][:, interior], K[interior][:, b]
+    Mii, Mib = M[interior][:, interior], M[interior][:, b]
+    timings = {}
+    t0 = time.perf_counter()
+    try:
+        lu = factorize(Kii)
+    except ValueError:
+        raise ValueError("the interior stiffness K_ii is singular: the interface (with the"
+                         " supports) does not restrain all rigid-body motions of every part;"
+                         " add interface DOFs") from None
+    t1 = time.perf_counter()
+    Psi = -lu.solve(Kib.toarray())
+    t2 = time.perf_counter()
+    omega2, Phi = _fixed_interface_modes(Kii, Mii, selection, lu)
+    t3 = time.perf_counter()
+    Kr, Mr = _project(K[b][:, b], Kib, Mii, Mib, M[b][:, b], Psi, Phi, omega2)
+    t4 = time.perf_counter()
+    timings.update(factorisation=t1 - t0, constraint_modes=t2 - t1,
+                   fixed_interface_modes=t3 - t2, projection=t4 - t3)
+    points = model.mesh.points[dofs // DOF_PER_NODE]
+    return Superelement(Kr, Mr, method, dofs, points, omega2, Psi, Phi, b, interior,
+                        model.T.tocsr(), timings, lu)
+
+
+def _fixed_interface_modes(Kii, Mii, selection, lu):
+    n_i = Kii.shape[0]
+    if selection is None or (selection[0] == "count" and selection[1] == 0):
+        return np.empty(0), np.empty((n_i, 0))
+    kind, value = selection
+    if kind == "count":
+        if value >= n_i:
+            raise ValueError(f"n_modes={value} but the interior has only {n_i} DOFs")
+        result = solve_symmetric(Kii, Mii, n_modes=value, sigma=0.0, factor=lu)
+    else:
+        result = solve_symmetric(Kii, Mii, band=(0.0, (2 * np.pi * value) ** 2), sigma=0.0,
+                                 factor=lu)
+    return result.omega2, result.vectors
+
+
+def _project(Kbb, Kib, Mii, Mib, Mbb, Psi, Phi, omega2):
+    """Reduced K, M of the basis [[I, 0], [Ψ, Φ]] (sparse-times-dense products only)."""
+    Kg = Kbb.toarray() + Kib.T @ Psi
+    MiiPsi = Mii @ Psi
+    Mg = Mbb.toarray() + Mib.T @ Psi + Psi.T @ (Mib.toarray() + MiiPsi)
+    Mbq = (Mib.T @ Phi) + MiiPsi.T @ Phi
+    n_b, n_q = Kg.shape[0], Phi.shape[1]
+    Kr = np.zeros((n_b + n_q, n_b + n_q))
+    Mr = np.zeros_like(Kr)
+    Kr[:n_b, :n_b] = 0.5 * (Kg + Kg.T)
+    Kr[n_b:, n_b:] = np.diag(omega2)
+    Mr[:n_b, :n_b] = 0.5 * (Mg + Mg.T)
+    Mr[:n_b, n_b:] = Mbq
+    Mr[n_b:, :n_b] = Mbq.T
+    Mr[n_b:, n_b:] = Phi.T @ (Mii @ Phi)
+    Mr[n_b:, n_b:] = 0.5 * (Mr[n_b:, n_b:] + Mr[n_b:, n_b:].T)
+    return Kr, Mr
+
+
+def frequency_error_estimates(model: FEModel, se: Superelement, omega2: np.ndarray,
+                              q: np.ndarray) -> np.ndarray:
+    """A-posteriori relative frequency errors of reduced eigenpairs, without a full solve.
+
+    For a Ritz pair (λ̃, x = T q) with mass-normalised x, the residual
+    ``r = K x - λ̃ M x`` vanishes on the interface in the reduced sense
+    (``r_b = -Ψᵀ r_i``), so ``K⁻¹ r = [0; K_ii⁻¹ r_i]`` and the eigenvalue error is
+    estimated by ``λ̃ - λ ≈ rᵀ (K - λ M)⁻¹ r ≈ r_iᵀ K_ii⁻¹ r_i`` (exact to first order
+    in λ / ω²_truncated). The relative frequency error is half the relative eigenvalue
+    error. Reuses the K_ii factorisation of the reduction.
+
+    Parameters
+    ----------
+    model : FEModel
+        The model that was reduced.
+    se : Superelement
+    omega2 : ndarray (n_modes,)
+        Reduced eigenvalues, rad²/s².
+    q : ndarray (n_r, n_modes)
+        Reduced eigenvectors, mass-normalised with ``se.M``.
+
+    Returns
+    -------
+    ndarray (n_modes,)
+        Estimated ``(f_reduced - f_full) / f_full``; 0 for rigid-body modes (λ̃ ≈ 0).
+    """
+    lu = se.interior_factor
+    K, M = model.K_free.tocsr(), model.M_free.tocsr()
+    interior = se.free_interior
+    if lu is None:
+        lu = factorize(K[interior][:, interior])
+    u = se.expand_free(q)
+    r = (K[interior] @ u) - (M[interior] @ u) * omega2
+    eta = np.einsum("ij,ij->j", r, lu.solve(r))
+    scale = np.abs(se.K).max() / max(np.abs(se.M).max(), 1e-300)
+    rigid = np.abs(omega2) <= 1e-12 * scale
+    return np.where(rigid, 0.0, 0.5 * eta / np.where(rigid, 1.0, omega2))
