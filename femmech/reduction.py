@@ -22,6 +22,8 @@ import json
 import os
 import tempfile
 import time
+import zipfile
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -38,6 +40,13 @@ interest (``f_max_hz``): with modes up to 2 f_max, Craig-Bampton frequencies bel
 are typically accurate to well below 0.1 % (see benchmarks/reduction.py)."""
 
 FORMAT_VERSION = 1
+
+PIVOT_RTOL = 1e-11
+"""A pivot of the ``K_ii`` factorisation below this fraction of its diagonal entry marks
+K_ii as singular. The zero pivot of an unrestrained interior comes out as round-off
+(measured -6e-16 and 1.3e-13 on free-free frames), while regular frames give ratios of
+1e-4 and more, and a 1e6 stiffness contrast 7e-9; below 1e-11 (cond(K_ii) > 1e11) a
+solve would keep fewer than five significant digits anyway."""
 
 
 @dataclass(frozen=True)
@@ -70,6 +79,8 @@ class Superelement:
     timings : dict[str, float]
         Seconds spent in ``factorisation``, ``constraint_modes``, ``fixed_interface_modes``
         and ``projection``.
+    n_residual : int
+        How many of the ``n_q`` modal coordinates are residual vectors (the last ones).
     """
 
     K: np.ndarray
@@ -84,6 +95,7 @@ class Superelement:
     free_interior: np.ndarray
     T: sp.csr_matrix
     timings: dict = field(default_factory=dict)
+    n_residual: int = 0
     interior_factor: object = field(default=None, compare=False, repr=False)
 
     @property
@@ -108,8 +120,10 @@ class Superelement:
 
     @property
     def kinds(self) -> np.ndarray:
-        """``"interface"`` or ``"modal"`` for each reduced coordinate, shape (n_r,)."""
-        return np.array(["interface"] * self.n_interface + ["modal"] * self.n_modal)
+        """``"interface"``, ``"modal"`` or ``"residual"`` per reduced coordinate, (n_r,)."""
+        n_fixed = self.n_modal - self.n_residual
+        return np.array(["interface"] * self.n_interface + ["modal"] * n_fixed
+                        + ["residual"] * self.n_residual)
 
     @property
     def modal_freq_hz(self) -> np.ndarray:
@@ -146,7 +160,7 @@ class Superelement:
         T = self.T.tocsr()
         arrays = {name: getattr(self, name) for name in _ARRAYS}
         meta = {"format_version": FORMAT_VERSION, "method": self.method,
-                "timings": self.timings, "n_dof": self.n_dof}
+                "timings": self.timings, "n_dof": self.n_dof, "n_residual": self.n_residual}
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".npz")
         try:
             with os.fdopen(fd, "wb") as stream:
@@ -161,16 +175,28 @@ class Superelement:
 
     @classmethod
     def load(cls, path) -> Superelement:
-        """Read a superelement written by :meth:`save`."""
-        with np.load(Path(path), allow_pickle=False) as data:
-            meta = json.loads(str(data["meta"]))
-            if meta.get("format_version") != FORMAT_VERSION:
-                raise ValueError(f"{path}: superelement format {meta.get('format_version')},"
-                                 f" expected {FORMAT_VERSION}")
-            T = sp.csr_matrix((data["T_data"], data["T_indices"], data["T_indptr"]),
-                              shape=tuple(data["T_shape"]))
-            arrays = {name: data[name] for name in _ARRAYS}
-        return cls(method=meta["method"], T=T, timings=meta["timings"], **arrays)
+        """Read a superelement written by :meth:`save`.
+
+        Raises ValueError naming the file if it is truncated, corrupt, not a superelement
+        file or of another format version.
+        """
+        try:
+            with np.load(Path(path), allow_pickle=False) as data:
+                meta = json.loads(str(data["meta"]))
+                if meta.get("format_version") == FORMAT_VERSION:
+                    T = sp.csr_matrix((data["T_data"], data["T_indices"], data["T_indptr"]),
+                                      shape=tuple(data["T_shape"]))
+                    arrays = {name: data[name] for name in _ARRAYS}
+        except FileNotFoundError:
+            raise
+        except (OSError, EOFError, KeyError, ValueError, zipfile.BadZipFile, zlib.error) as exc:
+            raise ValueError(f"{path}: not a readable superelement file (truncated or"
+                             f" corrupt? {type(exc).__name__}: {exc})") from exc
+        if meta.get("format_version") != FORMAT_VERSION:
+            raise ValueError(f"{path}: superelement format {meta.get('format_version')},"
+                             f" expected {FORMAT_VERSION}")
+        return cls(method=meta["method"], T=T, timings=meta["timings"],
+                   n_residual=meta.get("n_residual", 0), **arrays)
 
 
 _ARRAYS = ("K", "M", "interface_dofs", "interface_points", "modal_omega2", "Psi", "Phi",
@@ -227,7 +253,8 @@ def guyan(model: FEModel, interface) -> Superelement:
 
 
 def craig_bampton(model: FEModel, interface, n_modes: int | None = None,
-                  cutoff_hz: float | None = None, f_max_hz: float | None = None) -> Superelement:
+                  cutoff_hz: float | None = None, f_max_hz: float | None = None,
+                  residual_vectors: bool = False) -> Superelement:
     """Craig-Bampton reduction: interface DOFs + fixed-interface normal modes.
 
     Parameters
@@ -240,6 +267,15 @@ def craig_bampton(model: FEModel, interface, n_modes: int | None = None,
         Keep all fixed-interface modes below this frequency, Hz.
     f_max_hz : float, optional
         Highest frequency of interest, Hz; keeps modes below ``CUTOFF_FACTOR * f_max_hz``.
+    residual_vectors : bool
+        Augment the basis with the static response of the interior to the inertia
+        forces of unit interface accelerations, ``K_ii⁻¹ (M_ii Ψ + M_ib)``, made
+        M-orthogonal to the kept modes (the truncated modes' quasi-static part, cf.
+        Dickens & Stroeve, "Modal truncation vectors for reduced dynamic substructure
+        models", AIAA 2000-1578). Costs n_b solves with the existing factorisation and
+        adds up to n_b coordinates (kind ``"residual"``); on the shipped machine frame it
+        lowers the error of the 10 lowest modes with 10 fixed-interface modes from 7e-3
+        to 6e-7.
 
     Give exactly one of ``n_modes``, ``cutoff_hz`` and ``f_max_hz``.
 
@@ -259,10 +295,12 @@ def craig_bampton(model: FEModel, interface, n_modes: int | None = None,
     if n_modes is not None and n_modes < 0:
         raise ValueError(f"n_modes must be >= 0, got {n_modes}")
     selection = ("count", int(n_modes)) if n_modes is not None else ("cutoff", cutoff_hz)
-    return _reduce(model, interface, selection, method="craig-bampton")
+    return _reduce(model, interface, selection, method="craig-bampton",
+                   residual_vectors=residual_vectors)
 
 
-def _reduce(model: FEModel, interface, selection, method: str) -> Superelement:
+def _reduce(model: FEModel, interface, selection, method: str,
+            residual_vectors: bool = False) -> Superelement:
     dofs = interface_dofs(model, interface)
     b = np.searchsorted(model.free, dofs)
     interior = np.setdiff1d(np.arange(model.n_free), b)
@@ -273,16 +311,16 @@ def _reduce(model: FEModel, interface, selection, method: str) -> Superelement:
     Mii, Mib = M[interior][:, interior], M[interior][:, b]
     timings = {}
     t0 = time.perf_counter()
-    try:
-        lu = factorize(Kii)
-    except ValueError:
-        raise ValueError("the interior stiffness K_ii is singular: the interface (with the"
-                         " supports) does not restrain all rigid-body motions of every part;"
-                         " add interface DOFs") from None
+    lu = _factorize_interior(Kii, model.free[interior])
     t1 = time.perf_counter()
     Psi = -lu.solve(Kib.toarray())
     t2 = time.perf_counter()
     omega2, Phi = _fixed_interface_modes(Kii, Mii, selection, lu)
+    n_residual = 0
+    if residual_vectors:
+        more_omega2, more_Phi = _residual_vectors(Kii, Mii, Mib, Psi, Phi, lu)
+        omega2, Phi = np.concatenate([omega2, more_omega2]), np.hstack([Phi, more_Phi])
+        n_residual = more_omega2.size
     t3 = time.perf_counter()
     Kr, Mr = _project(K[b][:, b], Kib, Mii, Mib, M[b][:, b], Psi, Phi, omega2)
     t4 = time.perf_counter()
@@ -290,7 +328,29 @@ def _reduce(model: FEModel, interface, selection, method: str) -> Superelement:
                    fixed_interface_modes=t3 - t2, projection=t4 - t3)
     points = model.mesh.points[dofs // DOF_PER_NODE]
     return Superelement(Kr, Mr, method, dofs, points, omega2, Psi, Phi, b, interior,
-                        model.T.tocsr(), timings, lu)
+                        model.T.tocsr(), timings, n_residual, lu)
+
+
+def _factorize_interior(Kii, dofs):
+    """LU of ``K_ii``; ValueError naming a DOF of a zero pivot if K_ii is singular.
+
+    SuperLU rarely stops on a singular symmetric matrix: the zero pivot of an unrestrained
+    motion comes out as round-off, so every pivot is compared with its diagonal entry
+    (for positive definite K_ii, ``λ_min <= pivot <= diagonal``).
+    """
+    try:
+        lu = factorize(Kii)
+        order = np.argsort(lu.perm_c)  # column j of the factors is column order[j] of K_ii
+        ratio = lu.U.diagonal() / np.abs(Kii.diagonal()[order])
+        bad = np.flatnonzero(~(ratio > PIVOT_RTOL))
+        where = f" (zero pivot at {dof_label(int(dofs[order[bad[0]]]))})" if bad.size else ""
+    except ValueError:
+        bad, where = [0], ""
+    if len(bad):
+        raise ValueError(f"the interior stiffness K_ii is singular{where}: the interface (with"
+                         " the supports) does not restrain all rigid-body motions of every"
+                         " part; add interface DOFs")
+    return lu
 
 
 def _fixed_interface_modes(Kii, Mii, selection, lu):
@@ -306,6 +366,26 @@ def _fixed_interface_modes(Kii, Mii, selection, lu):
         result = solve_symmetric(Kii, Mii, band=(0.0, (2 * np.pi * value) ** 2), sigma=0.0,
                                  factor=lu)
     return result.omega2, result.vectors
+
+
+def _residual_vectors(Kii, Mii, Mib, Psi, Phi, lu):
+    """Residual vectors, as K- and M-orthogonal pseudo-modes (ω², vectors) (n_i, <= n_b).
+
+    ``R = K_ii⁻¹ (M_ii Ψ + M_ib)`` minus its M-projection on Φ; a Rayleigh-Ritz solve
+    in span(R) makes the vectors mutually K- and M-orthogonal (they are K-orthogonal to
+    Φ because ``Φᵀ K_ii R = Λ Φᵀ M_ii R = 0``). Directions of relative M-norm below
+    1e-10 (linearly dependent ones) are dropped.
+    """
+    R = lu.solve(Mii @ Psi + Mib.toarray())
+    for _ in range(2):  # twice is enough (Kahan-Parlett) for M-orthogonality to Φ
+        R = R - Phi @ (Phi.T @ (Mii @ R))
+    gram = R.T @ (Mii @ R)
+    w, V = np.linalg.eigh(0.5 * (gram + gram.T))
+    keep = w > 1e-10 * max(w.max(), 1e-300)
+    R = R @ (V[:, keep] / np.sqrt(w[keep]))
+    stiff = R.T @ (Kii @ R)
+    omega2, Z = np.linalg.eigh(0.5 * (stiff + stiff.T))
+    return omega2, R @ Z
 
 
 def _project(Kbb, Kib, Mii, Mib, Mbb, Psi, Phi, omega2):

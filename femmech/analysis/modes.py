@@ -8,6 +8,7 @@ import numpy as np
 
 from femmech.linalg import eigenvalue_scale, solve_symmetric
 from femmech.model import FEModel
+from femmech.reduction import Superelement, frequency_error_estimates
 
 RIGID_TOL = 1e-12
 """Eigenvalues with ``|ω²| <= RIGID_TOL * scale`` are rigid-body modes (scale: see
@@ -39,6 +40,10 @@ class ModeSet:
         Relative residual of each eigenpair.
     sturm_count : int or None
         Sturm-sequence count that confirmed the result (None if not checked).
+    error_estimate : ndarray (n_modes,) or None
+        For modes of a reduced model: a-posteriori estimate of the relative frequency
+        error against the unreduced model (see
+        :func:`femmech.reduction.frequency_error_estimates`).
     """
 
     freq_hz: np.ndarray
@@ -49,6 +54,7 @@ class ModeSet:
     sigma: float
     residual: np.ndarray
     sturm_count: int | None
+    error_estimate: np.ndarray | None = None
 
     @property
     def n_modes(self) -> int:
@@ -101,18 +107,55 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
     >>> result.freq_hz.round(1).tolist()  # two equal bending modes (Euler-Bernoulli: 14.47 Hz)
     [14.5, 14.5]
     """
-    if band_hz is not None:
-        lo, hi = (float(v) for v in band_hz)
-        if not 0 <= lo < hi:
-            raise ValueError(f"band_hz must be (low, high) with 0 <= low < high, got {band_hz}")
-        band = ((2 * np.pi * lo) ** 2, (2 * np.pi * hi) ** 2)
-    else:
-        band = None
+    band = _band(band_hz)
     if model.n_free == 0:
         raise ValueError("all DOFs are constrained: the model has no free DOF")
     Kf, Mf = model.K_free, model.M_free
     result = solve_symmetric(Kf, Mf, n_modes=n_modes, band=band, sigma=sigma, check=check)
-    rigid = np.abs(result.omega2) <= RIGID_TOL * eigenvalue_scale(Kf, Mf)
+    return _mode_set(result, model.expand(result.vectors), eigenvalue_scale(Kf, Mf))
+
+
+def superelement_modes(se: Superelement, n_modes: int | None = None,
+                       band_hz: tuple[float, float] | None = None,
+                       model: FEModel | None = None) -> ModeSet:
+    """Modes of a reduced model, ``K_r q = ω² M_r q``, recovered to all DOFs.
+
+    Parameters
+    ----------
+    se : Superelement
+    n_modes, band_hz
+        As in :func:`modes` (dense LAPACK on the reduced matrices).
+    model : FEModel, optional
+        The model that was reduced; when given, each mode gets an a-posteriori estimate
+        of its relative frequency error (:attr:`ModeSet.error_estimate`), computed from
+        the residual in the full model without a full eigen solve.
+
+    Returns
+    -------
+    ModeSet
+        ``shapes`` are the recovered full-model shapes (n_dof, n_modes).
+    """
+    Kr, Mr = se.K, se.M
+    result = solve_symmetric(Kr, Mr, n_modes=n_modes, band=_band(band_hz),
+                             dense_below=np.iinfo(np.int64).max)
+    estimate = None
+    if model is not None:
+        estimate = frequency_error_estimates(model, se, result.omega2, result.vectors)
+    return _mode_set(result, se.recover(result.vectors), eigenvalue_scale(Kr, Mr), estimate)
+
+
+def _band(band_hz):
+    """Band in rad²/s² from Hz, checked; None passes through."""
+    if band_hz is None:
+        return None
+    lo, hi = (float(v) for v in band_hz)
+    if not 0 <= lo < hi:
+        raise ValueError(f"band_hz must be (low, high) with 0 <= low < high, got {band_hz}")
+    return ((2 * np.pi * lo) ** 2, (2 * np.pi * hi) ** 2)
+
+
+def _mode_set(result, shapes, scale, estimate=None) -> ModeSet:
+    rigid = np.abs(result.omega2) <= RIGID_TOL * scale
     freq = np.where(rigid, 0.0, np.sqrt(np.clip(result.omega2, 0.0, None)) / (2 * np.pi))
-    return ModeSet(freq, result.omega2, model.expand(result.vectors), rigid, result.method,
-                   result.sigma, result.residual, result.sturm_count)
+    return ModeSet(freq, result.omega2, shapes, rigid, result.method, result.sigma,
+                   result.residual, result.sturm_count, estimate)

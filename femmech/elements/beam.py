@@ -144,8 +144,9 @@ def bending_matrices(length, EI, GAs, rhoA, rhoI):
     K *= a[:, None, None]
     Nw, Nt = bending_shape_functions(_XI, L, phi)
     wL = _WEIGHTS[None, :] * L[:, None]
-    M = np.einsum("eq,eqi,eqj->eij", wL * rhoA[:, None], Nw, Nw)
-    M += np.einsum("eq,eqi,eqj->eij", wL * rhoI[:, None], Nt, Nt)
+    # M = Σ_q w_q L (ρA Nwᵀ Nw + ρI Nθᵀ Nθ) at the Gauss points, as batched 4x4 products
+    M = np.swapaxes(Nw * (wL * rhoA[:, None])[:, :, None], 1, 2) @ Nw
+    M += np.swapaxes(Nt * (wL * rhoI[:, None])[:, :, None], 1, 2) @ Nt
     return K, M
 
 
@@ -182,9 +183,12 @@ def local_matrices(length, E, G, rho, A, Iy, Iz, J, Ip, Asy, Asz, rotary_inertia
 def rotate_to_global(R: np.ndarray, A_local: np.ndarray) -> np.ndarray:
     """``Tᵀ A T`` with ``T = blockdiag(R, R, R, R)``; R (n, 3, 3), A (n, 12, 12)."""
     n = len(R)
-    blocks = A_local.reshape(n, 4, 3, 4, 3)
-    out = np.einsum("nji,najbk,nkl->naibl", R, blocks, R, optimize=True)
-    return out.reshape(n, 12, 12)
+    T = np.zeros((n, 4, 3, 4, 3))
+    for a in range(4):
+        T[:, a, :, a, :] = R
+    T = T.reshape(n, 12, 12)
+    # batched 12x12 products: ~1.5x faster than the structured einsum path (benchmarks/)
+    return np.swapaxes(T, 1, 2) @ A_local @ T
 
 
 def beam_matrices(points, cells, orientation, E, G, rho, A, Iy, Iz, J, Ip, Asy, Asz,
