@@ -5,7 +5,7 @@ Importing femmech has no side effects and does not import pyvista (see
 """
 
 from femmech.analysis.modes import ModeSet, modes
-from femmech.constraints import RigidLink, Support
+from femmech.constraints import InterpolatingLink, RigidLink, Support
 from femmech.errors import FemmechWarning
 from femmech.io import read_mesh
 from femmech.lumped import PointMass, Spring
@@ -21,6 +21,7 @@ __all__ = [
     "BeamSection",
     "FEModel",
     "FemmechWarning",
+    "InterpolatingLink",
     "Material",
     "Mesh",
     "ModeSet",

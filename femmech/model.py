@@ -15,7 +15,16 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from femmech.assembly import assemble
-from femmech.constraints import RigidLink, Support, constraint_transform, fixed_mask
+from femmech.constraints import (
+    EquationSet,
+    InterpolatingLink,
+    RigidLink,
+    Support,
+    add_interpolating_link,
+    add_rigid_links,
+    constraint_transform,
+    fixed_mask,
+)
 from femmech.dofs import DOF_PER_NODE, element_dofs, node_dofs
 from femmech.elements.beam import beam_matrices, local_frames
 from femmech.lumped import PointMass, Spring
@@ -129,7 +138,7 @@ class FEModel:
 
 
 def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(),
-                supports=(), rigid_links=()) -> FEModel:
+                supports=(), rigid_links=(), interpolating_links=()) -> FEModel:
     """Assemble an :class:`FEModel`.
 
     Parameters
@@ -141,6 +150,9 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(
     springs : sequence of Spring
     supports : sequence of Support
     rigid_links : sequence of RigidLink
+        RBE2-like links (chains allowed: a master may be the slave of another link).
+    interpolating_links : sequence of InterpolatingLink
+        RBE3-like links: a reference node follows the average motion of a patch.
 
     Raises
     ------
@@ -149,7 +161,7 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(
         without or with two properties, unused nodes, coincident nodes that no spring or
         rigid link joins, zero-length elements, orientation vectors along an element.
     """
-    _check_types(beams, masses, springs, supports, rigid_links)
+    _check_types(beams, masses, springs, supports, rigid_links, interpolating_links)
     beam_set, Ke, Me, edofs = _beam_blocks(mesh, beams)
     n_dof = DOF_PER_NODE * mesh.n_nodes
     stiff_blocks = [(edofs, Ke)]
@@ -175,15 +187,23 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(
         used[b] = True
         joined.append((a, b))
         stiff_blocks.append((node_dofs([a, b])[None, :], np.block([[k, -k], [-k, k]])[None]))
-    masters, slaves = _rigid_pairs(mesh, rigid_links)
-    used[masters] = True
-    used[slaves] = True
-    joined.extend(zip(masters.tolist(), slaves.tolist(), strict=True))
+    masters, slaves, labels = _rigid_pairs(mesh, rigid_links)
+    spiders = _spider_nodes(mesh, interpolating_links)
+    for m, s in [(masters, slaves)] + [(np.full(p.size, r), p) for r, p, _, _ in spiders]:
+        used[m] = True
+        used[s] = True
+        joined.extend(zip(m.tolist(), s.tolist(), strict=True))
     _check_nodes(mesh, used, joined)
     fixed = np.zeros(n_dof, dtype=bool)
     for item in supports:
         fixed |= fixed_mask(mesh.n_nodes, node_indices(mesh, item.nodes, "support"), item.dofs)
-    T, free = constraint_transform(mesh.points, fixed, masters, slaves)
+    eqs = EquationSet.empty()
+    add_rigid_links(eqs, mesh.points, masters, slaves, labels)
+    for reference, patch, weights, label in spiders:
+        blocked = fixed.copy()
+        blocked[eqs.dependent()] = True
+        add_interpolating_link(eqs, mesh.points, reference, patch, weights, blocked, label)
+    T, free = constraint_transform(n_dof, fixed, eqs)
     K = assemble(stiff_blocks, n_dof)
     M = assemble(mass_blocks, n_dof)
     Tt = T.T.tocsr()
@@ -192,13 +212,15 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(
                    (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr())
 
 
-def _check_types(beams, masses, springs, supports, rigid_links):
+def _check_types(beams, masses, springs, supports, rigid_links, interpolating_links):
     if not isinstance(beams, Mapping):
         raise TypeError(f"beams must be a dict {{cell-set name: BeamProperty}},"
                         f" got {type(beams).__name__}")
     for label, items, kind in (("masses", masses, PointMass), ("springs", springs, Spring),
                                ("supports", supports, Support),
-                               ("rigid_links", rigid_links, RigidLink)):
+                               ("rigid_links", rigid_links, RigidLink),
+                               ("interpolating_links", interpolating_links,
+                                InterpolatingLink)):
         for i, item in enumerate(items):
             if not isinstance(item, kind):
                 raise TypeError(f"{label}[{i}] must be a {kind.__name__},"
@@ -301,7 +323,8 @@ def node_indices(mesh: Mesh, ref, what: str) -> np.ndarray:
 
 
 def _rigid_pairs(mesh: Mesh, links):
-    masters, slaves = [], []
+    """Master, slave and label per slave node of all rigid links."""
+    masters, slaves, labels = [], [], []
     for link in links:
         m = node_index(mesh, link.master, "rigid link master")
         s = node_indices(mesh, link.slaves, "rigid link slaves")
@@ -310,9 +333,21 @@ def _rigid_pairs(mesh: Mesh, links):
             raise ValueError(f"rigid link with master {link.master!r} has no slave nodes")
         masters.append(np.full(s.size, m))
         slaves.append(s)
+        labels.extend([f"rigid link (master {m})"] * s.size)
     if not masters:
-        return np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
-    return np.concatenate(masters), np.concatenate(slaves)
+        return np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64), []
+    return np.concatenate(masters), np.concatenate(slaves), labels
+
+
+def _spider_nodes(mesh: Mesh, links):
+    """(reference, patch, weights, label) of each interpolating link."""
+    out = []
+    for link in links:
+        r = node_index(mesh, link.reference, "interpolating link reference")
+        p = node_indices(mesh, link.patch, "interpolating link patch")
+        p = np.unique(p[p != r])
+        out.append((r, p, link.weights, f"interpolating link (reference {r})"))
+    return out
 
 
 def _check_nodes(mesh: Mesh, used: np.ndarray, joined) -> None:

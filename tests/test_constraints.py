@@ -181,8 +181,10 @@ def _link_errors_mesh():
 
 
 @pytest.mark.parametrize(("links", "supports", "match"), [
-    ([fm.RigidLink(1, [2, 3]), fm.RigidLink(4, [3])], [], "node 3 is a slave of more than one"),
-    ([fm.RigidLink(1, [2]), fm.RigidLink(2, [3])], [], "node 2 is the master of one rigid link"),
+    ([fm.RigidLink(1, [2, 3]), fm.RigidLink(4, [3])], [],
+     r"node 3 ux is dependent in two constraints: rigid link \(master 1\) and rigid link"),
+    ([fm.RigidLink(1, [2]), fm.RigidLink(2, [1]), fm.RigidLink(4, [3])], [],
+     "constraints form a cycle"),
     ([fm.RigidLink(1, [2, 3])], [fm.Support(3, ["uy"])], "node 3 uy is both supported"),
     ([fm.RigidLink(1, [])], [], "rigid link with master 1 has no slave nodes"),
     ([fm.RigidLink(1, [1])], [], "rigid link with master 1 has no slave nodes"),
@@ -190,6 +192,8 @@ def _link_errors_mesh():
     ([fm.RigidLink("nowhere", [2, 3])], [], "rigid link master: unknown group 'nowhere'"),
 ])
 def test_rigid_link_errors(links, supports, match):
+    # (a chain, where a master is the slave of another link, is valid: see
+    # test_chained_rigid_links_move_rigidly)
     mesh = _link_errors_mesh()
     with pytest.raises(ValueError, match=match):
         fm.build_model(mesh, {"all": fm.BeamProperty(SECTION, STEEL)}, supports=supports,
@@ -262,3 +266,18 @@ def test_rigid_link_dense_eigenproblem_matches_hand_elimination():
     result = fm.modes(model, n_modes=4)
     # dense LAPACK on both sides: round-off, relative to ω²
     assert_allclose(result.omega2[:4], ref, rtol=1e-9)
+
+
+def test_chained_rigid_links_move_rigidly():
+    # Link 1 -> 2 and link 2 -> 3: node 3 follows node 1 through node 2, so both slaves
+    # move with node 1 as one rigid body: u_s = u_1 + θ_1 × (x_s - x_1), θ_s = θ_1.
+    mesh = _link_errors_mesh()
+    model = fm.build_model(mesh, {"all": fm.BeamProperty(SECTION, STEEL)},
+                           rigid_links=[fm.RigidLink(1, [2]), fm.RigidLink(2, [3])])
+    rng = np.random.default_rng(3)
+    u = model.expand(rng.standard_normal(model.n_free)).reshape(-1, 6)
+    for s in (2, 3):
+        r = mesh.points[s] - mesh.points[1]
+        # a product of exact sparse matrices: round-off only
+        assert_allclose(u[s, :3], u[1, :3] + np.cross(u[1, 3:], r), rtol=0, atol=1e-14)
+        assert_allclose(u[s, 3:], u[1, 3:], rtol=0, atol=1e-14)
