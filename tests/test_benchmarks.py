@@ -26,27 +26,32 @@ def test_frame_modes_benchmark_runs_and_reports_sane_rows(frame_modes, tmp_path)
     # 108 elements; the 9 base joints are fixed (6 DOFs each)
     assert (modal["dofs"], modal["free_dofs"], modal["elements"]) == (486, 432, 108)
     assert modal["method"] == "arpack"  # 432 free DOFs > DENSE_BELOW: the timed sparse path
-    # all phase times are non-negative and the phases do not exceed their totals
-    # (the "other" part absorbs the rest; 1 ms slack for clock granularity)
-    for parts, total in ((("element_s", "coo_csr_s", "tkt_s"), "build_s"),
-                         (("factor_s", "arpack_s", "sturm_s"), "eigen_s")):
-        assert all(modal[p] >= 0 for p in parts)
-        assert sum(modal[p] for p in parts) <= modal[total] + 1e-3
-    assert modal["build_peak_mb"] >= 0 and modal["eigen_peak_mb"] >= 0
+    # phase times and memory are reported as non-negative numbers (values not asserted:
+    # no timing in tests)
+    for key in ("element_s", "coo_csr_s", "tkt_s", "build_s", "factor_s", "arpack_s",
+                "sturm_s", "eigen_s"):
+        assert modal[key] >= 0
+    assert modal["build_peak_mb"] >= 0
+    assert modal["eigen_peak_mb"] >= 0
     # >= 20 modes (a repeated 20th eigenvalue brings its whole cluster), all confirmed by
     # the Sturm count; supported frame: no rigid-body modes
-    assert modal["n_modes"] >= 20 and modal["sturm_count"] == modal["n_modes"]
+    assert modal["n_modes"] >= 20
+    assert modal["sturm_count"] == modal["n_modes"]
     assert modal["n_rigid"] == 0
     f = np.array(modal["f123_hz"])
-    assert f.shape == (3,) and np.all(f > 0) and np.all(np.diff(f) >= 0)
-    # residual and errors against dense LAPACK and scipy's eigsh: round-off level for a
-    # 432-DOF system (eigen solver tolerance ~1e-12 relative, far below 1e-8)
+    assert f.shape == (3,)
+    assert np.all(f > 0)
+    assert np.all(np.diff(f) >= 0)
+    # residual and errors against dense LAPACK and scipy's eigsh: both solve the same
+    # pencil to round-off (ARPACK tol=0 means machine precision; observed ~1e-12 for this
+    # 432-DOF system), so 1e-8 leaves a wide margin without hiding a wrong mode
     assert modal["max_residual"] < 1e-8
     refs = modal["references"]
     assert [r["ref_s"] is not None for r in refs] == [True, True]
     assert all(r["max_rel_err"] < 1e-8 for r in refs)
     # the loop and vectorised assemblies give the same matrices up to summation order
-    assert assembly["elements"] == 108 and assembly["speedup"] > 0
+    assert assembly["elements"] == 108
+    assert assembly["speedup"] > 0
     assert assembly["max_diff"] < 1e-12
     text = out.read_text()
     for heading in ("Build", "Modes", "Reference", "Assembly", "BLAS threads"):
