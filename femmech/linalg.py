@@ -141,14 +141,34 @@ def _complete_cluster(omega2: np.ndarray, n_wanted: int, rtol: float = 1e-6) -> 
     return n
 
 
-def _dense(K, M, sigma):
+SINGULAR_MASS_RTOL = 1e-12
+"""M counts as singular when its smallest Cholesky pivot is below this fraction of its
+largest diagonal entry (massless DOFs); the eigenproblem is then solved in the
+shift-inverted form, which drops their infinite eigenvalues."""
+
+
+def mass_is_regular(M: np.ndarray) -> bool:
+    """True when the dense symmetric M is numerically positive definite (Cholesky)."""
+    try:
+        L = np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        return False
+    return bool((np.diag(L) ** 2).min() > SINGULAR_MASS_RTOL * np.diag(M).max())
+
+
+def dense_symmetric(K, M, n_modes: int | None = None, sigma: float | None = None):
+    """All (or the lowest ``n_modes``) eigenpairs of a dense symmetric pencil, ascending.
+
+    Uses ``scipy.linalg.eigh(K, M)`` when M is regular; with a singular M (massless
+    DOFs) it solves ``M x = μ (K - σ M) x``, ``λ = σ + 1/μ`` (σ < 0, default
+    :func:`default_shift`) and drops the infinite eigenvalues (μ ≈ 0).
+    """
     Kd = K.toarray() if sp.issparse(K) else np.asarray(K, dtype=float)
     Md = M.toarray() if sp.issparse(M) else np.asarray(M, dtype=float)
-    try:
-        omega2, X = sla.eigh(Kd, Md)
-        return omega2, X
-    except np.linalg.LinAlgError:
-        pass  # singular mass: solve M x = μ (K - σ M) x, λ = σ + 1/μ
+    if mass_is_regular(Md):
+        subset = None if n_modes is None else [0, min(n_modes, len(Md)) - 1]
+        return sla.eigh(Kd, Md, subset_by_index=subset)
+    sigma = default_shift(Kd, Md) if sigma is None else sigma
     try:
         mu, X = sla.eigh(Md, Kd - sigma * Md)
     except np.linalg.LinAlgError as exc:
@@ -157,7 +177,7 @@ def _dense(K, M, sigma):
         ) from exc
     finite = mu > 1e-12 * np.abs(mu).max()
     omega2 = sigma + 1.0 / mu[finite]
-    order = np.argsort(omega2)
+    order = np.argsort(omega2)[:n_modes]
     return omega2[order], X[:, finite][:, order]
 
 
@@ -239,7 +259,7 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         raise ValueError("a reused factorisation needs the shift sigma it was made with")
     shift = default_shift(K, M) if sigma is None else float(sigma)
     if n < dense_below:
-        omega2, X = _dense(K, M, shift)
+        omega2, X = dense_symmetric(K, M, sigma=shift)
         result = _select(omega2, X, n_modes, band)
         omega2, X = result
         method = "dense"

@@ -1,0 +1,219 @@
+"""Quasi-eigenfrequencies and quasi-eigenmodes of a coupled machine over the drive angle.
+
+At each frozen drive angle φ the coupled system (seed 5.2.2 eq. 9) gives the eigenproblem
+
+* ``C v = λ M v`` (λ = ω²) when C(φ) is symmetric and damping is ignored (LAPACK eigh),
+* the same with an unsymmetric C (LAPACK eig; complex λ flag flutter-type instability),
+* ``(s² M + s B + C) v = 0`` with damping, solved in first-order form
+  ``[[0, I], [-C, -B]] z = s [[I, 0], [0, M]] z`` (LAPACK eig).
+
+Modes are followed from angle to angle by the modal assurance criterion (MAC, mass
+weighted) and frequency continuity, solved as an assignment problem, so crossing branches
+keep their identity (they swap order) and veering branches keep theirs (they do not).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.optimize import linear_sum_assignment
+
+from femmech.coupling import CoupledSystem, assemble_at
+from femmech.linalg import dense_symmetric
+
+SYMMETRY_RTOL = 1e-10
+"""C(φ) counts as symmetric when ``max|C - Cᵀ| <= SYMMETRY_RTOL * max|C|``."""
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """Tracked quasi-modes over a set of drive angles.
+
+    Attributes
+    ----------
+    phi : ndarray (n_angles,)
+        Drive angles, rad.
+    freq_hz : ndarray (n_angles, n_modes)
+        Quasi-eigenfrequency of each tracked branch (column), Hz: ``sqrt(Re λ)/2π`` for
+        the undamped forms, the damped frequency ``Im s / 2π`` with damping.
+    eigenvalues : ndarray (n_angles, n_modes), complex
+        λ = ω² (undamped forms) or s (damped form) of each branch.
+    damping_ratio : ndarray (n_angles, n_modes)
+        ``-Re s / |s|`` (damped form); ``-Im λ / (2 Re λ)`` growth indicator for an
+        unsymmetric C (negative: a growing, flutter-type mode); 0 for symmetric C.
+    vectors : ndarray (n_angles, n, n_modes) or None
+        Mode shapes (global coordinates), mass-normalised, if requested.
+    mac_step : ndarray (n_angles, n_modes)
+        MAC of each branch with itself at the previous angle (1 at the first angle).
+    form : str
+        ``"symmetric"``, ``"unsymmetric"`` or ``"damped"`` (the most general used).
+    """
+
+    phi: np.ndarray
+    freq_hz: np.ndarray
+    eigenvalues: np.ndarray
+    damping_ratio: np.ndarray
+    vectors: np.ndarray | None
+    mac_step: np.ndarray
+    form: str
+
+
+def frozen_modes(M, B, C, n_modes: int, damped: bool = False):
+    """Lowest quasi-modes at one angle (dense): (eigenvalues, freq_hz, ratio, V, form)."""
+    M, B, C = (np.asarray(A) for A in (M, B, C))
+    scale = max(np.abs(C).max(), 1e-300)
+    symmetric = np.abs(C - C.T).max() <= SYMMETRY_RTOL * scale
+    if damped:
+        n = M.shape[0]
+        A = np.block([[np.zeros((n, n)), np.eye(n)], [-C, -B]])
+        E = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), M]])
+        s, Z = sla.eig(A, E)
+        finite = np.isfinite(s) & (s.imag > 0)
+        s, V = s[finite], Z[:n, finite]
+        order = np.argsort(s.imag)[:n_modes]
+        s, V = s[order], V[:, order]
+        return s, s.imag / (2 * np.pi), -s.real / np.abs(s), _normalise(V, M), "damped"
+    if symmetric:
+        lam, V = dense_symmetric(0.5 * (C + C.T), M, n_modes)
+        freq = np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi)
+        return lam.astype(complex), freq, np.zeros(n_modes), V, "symmetric"
+    lam, V = sla.eig(C, M)
+    finite = np.isfinite(lam)
+    lam, V = lam[finite], V[:, finite]
+    order = np.argsort(lam.real)[:n_modes]
+    lam, V = lam[order], V[:, order]
+    freq = np.sqrt(np.clip(lam.real, 0.0, None)) / (2 * np.pi)
+    ratio = np.where(lam.real > 0, -lam.imag / (2 * np.abs(lam.real) + 1e-300), 0.0)
+    return lam, freq, ratio, _normalise(V, M), "unsymmetric"
+
+
+def _normalise(V, M):
+    norms = np.sqrt(np.abs(np.einsum("ij,ij->j", V.conj(), M @ V)))
+    return V / np.where(norms > 0, norms, 1.0)
+
+
+def mac_matrix(X, Y, W=None) -> np.ndarray:
+    """MAC_ij = |x_iᴴ W y_j|² / ((x_iᴴ W x_i)(y_jᴴ W y_j)); X (n, p), Y (n, q) → (p, q)."""
+    WY = Y if W is None else W @ Y
+    WX = X if W is None else W @ X
+    num = np.abs(X.conj().T @ WY) ** 2
+    nx = np.real(np.einsum("ij,ij->j", X.conj(), WX))
+    ny = np.real(np.einsum("ij,ij->j", Y.conj(), WY))
+    return num / np.outer(nx, ny)
+
+
+def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0,
+          n_modes: int = 6, damped: bool = False, track: bool = True,
+          keep_vectors: bool = False, frequency_weight: float = 0.1) -> Sweep:
+    """Quasi-modes of a coupled machine at many drive angles, with mode tracking.
+
+    Parameters
+    ----------
+    system : CoupledSystem
+        With a reduced (dense) frame; for an unreduced frame use :func:`full_modes`.
+    phi : array_like (n_angles,)
+        Drive angles, rad, in sweep order (e.g. ``np.linspace(0, 2π, 361)``).
+    Omega, Omega_dot : float
+        Drive speed (rad/s) and acceleration (rad/s²); Ω = 0 gives the potential part
+        of C only (symmetric for position-independent loads).
+    n_modes : int
+        Number of branches to follow.
+    damped : bool
+        Include B(φ) (first-order form); otherwise B is ignored.
+    track : bool
+        Follow branches by MAC + frequency continuity; otherwise sort by frequency.
+    keep_vectors : bool
+        Store the mode shapes (n_angles, n, n_modes).
+    frequency_weight : float
+        Weight of the relative frequency jump against ``1 - MAC`` in the assignment.
+
+    Returns
+    -------
+    Sweep
+    """
+    if system.is_sparse:
+        raise ValueError("sweep needs a reduced frame (Superelement or Assembly of"
+                         " superelements); use full_modes for an unreduced frame")
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    if not 0 < n_modes < system.n:
+        raise ValueError(f"n_modes must lie in 1..{system.n - 1}, got {n_modes}")
+    extra = min(n_modes + max(2, n_modes // 2), system.n - (0 if damped else 1))
+    blocks = system.mechanism_blocks(phi, Omega, Omega_dot)
+    n_angles = phi.size
+    lam = np.zeros((n_angles, n_modes), dtype=complex)
+    freq = np.zeros((n_angles, n_modes))
+    ratio = np.zeros((n_angles, n_modes))
+    mac_step = np.ones((n_angles, n_modes))
+    vectors = np.zeros((n_angles, system.n, n_modes), dtype=complex) if keep_vectors else None
+    forms, previous = set(), None
+    for a in range(n_angles):
+        M, B, C, _ = assemble_at(system, blocks, a)
+        ev, f, r, V, form = frozen_modes(M, B, C, extra, damped)
+        forms.add(form)
+        if track and previous is not None:
+            pick, macs = _assign(previous, V, f, M, frequency_weight)
+        else:
+            pick, macs = np.arange(n_modes), np.ones(n_modes)
+        lam[a], freq[a], ratio[a], mac_step[a] = ev[pick], f[pick], r[pick], macs
+        previous = (V[:, pick], f[pick])
+        if keep_vectors:
+            vectors[a] = V[:, pick]
+    form = "damped" if "damped" in forms else ("unsymmetric" if "unsymmetric" in forms
+                                                else "symmetric")
+    if vectors is not None and form == "symmetric":
+        vectors = vectors.real
+    return Sweep(phi, freq, lam, ratio, vectors, mac_step, form)
+
+
+def _assign(previous, V, f, M, weight):
+    """Columns of V continuing each previous branch (Hungarian assignment)."""
+    V_prev, f_prev = previous
+    mac = mac_matrix(V_prev, V, M)
+    jump = np.abs(f[None, :] - f_prev[:, None]) / np.maximum(f_prev[:, None], 1e-12)
+    rows, cols = linear_sum_assignment(1.0 - mac + weight * jump)
+    order = np.argsort(rows)
+    pick = cols[order]
+    return pick, mac[rows[order], pick]
+
+
+def frequency_sensitivities(build, p: float, phi: float, n_modes: int, Omega: float = 0.0,
+                            rel_step: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+    """Quasi-eigenfrequencies and their derivatives with respect to a parameter.
+
+    For ``C v = λ M v`` with symmetric C and mass-normalised v,
+    ``dλ/dp = vᵀ (dC/dp - λ dM/dp) v`` (Fox & Kapoor, AIAA J. 6 (1968) 2426), and
+    ``df/dp = dλ/dp / (8 π² f)``. The matrix derivatives are central differences of the
+    coupled matrices (cheap: no eigen solve), so any parameter of the frame, the
+    mounts or the mechanisms can be studied through ``build``.
+
+    Parameters
+    ----------
+    build : callable
+        ``build(p) -> CoupledSystem`` (reduced frame).
+    p : float
+        Parameter value (its own unit).
+    phi : float
+        Drive angle, rad.
+    n_modes : int
+    Omega : float
+        Drive speed, rad/s (C must stay symmetric: use 0 or a symmetric case).
+    rel_step : float
+        Relative step of the matrix differences (``h = rel_step * max(|p|, 1)``).
+
+    Returns
+    -------
+    freq_hz : ndarray (n_modes,)
+    dfreq_dp : ndarray (n_modes,), Hz per unit of p
+    """
+    M, _, C, _ = build(p).matrices(phi, Omega)
+    lam, freq, _, V, form = frozen_modes(M, M, C, n_modes)
+    if form != "symmetric":
+        raise ValueError("sensitivities need a symmetric C(φ); use Omega = 0")
+    h = rel_step * max(abs(p), 1.0)
+    Mp, _, Cp, _ = build(p + h).matrices(phi, Omega)
+    Mm, _, Cm, _ = build(p - h).matrices(phi, Omega)
+    dM, dC = (Mp - Mm) / (2 * h), (Cp - Cm) / (2 * h)
+    dlam = np.einsum("ij,ij->j", V, (dC @ V) - (dM @ V) * lam.real)
+    return freq, dlam / (8 * np.pi**2 * freq)

@@ -1,0 +1,333 @@
+"""Frame-mechanism coupling: rheolinear mechanisms mounted on frames.
+
+A coupled machine has global coordinates ``x = [u; q_own]``: the frame coordinates u
+(reduced coordinates of a :class:`~femmech.reduction.Superelement`, global coordinates
+of an :class:`~femmech.substructures.Assembly`, or free DOFs of an unreduced
+:class:`~femmech.model.FEModel`) followed by the mechanisms' own vibration coordinates.
+A mechanism coordinate attached *rigidly* to the frame is the frame motion
+``q_c = L u`` (DOF compatibility, primal assembly); an *elastic* attachment keeps q_c as
+an own coordinate and adds a bearing spring/damper ``½ k (q_c - L u)²``. ``L`` is a
+weighted combination of the six DOFs (ux, uy, uz, rx, ry, rz) of a frame node, e.g. a
+guide direction or a shaft's torsion component.
+
+With ``q_m = P x`` for each mechanism (P constant and sparse), the coupled rheolinear
+system of seed 5.2.2 eq. 9 at drive angle φ is
+
+    M(φ) = M_0 + Σ Pᵀ M_m(φ_m) P,  B(φ) = B_0 + Σ Pᵀ B_m P,  C(φ) = K_0 + Σ Pᵀ C_m P,
+    F(φ) = Σ Pᵀ F_m,
+
+with φ_m = ratio_m φ + phase_m. The constant frame part is assembled once; per angle only
+the small mechanism blocks are evaluated (vectorised over all angles) and added on the
+few coordinates they touch. Symbols: M mass, B damping, C stiffness, F force (the
+chapter's); the frame's K is C_0.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from femmech.dofs import COMPONENTS, DOF_PER_NODE
+from femmech.model import FEModel, node_index
+from femmech.reduction import Superelement
+from femmech.substructures import Assembly
+
+
+@dataclass(frozen=True)
+class Attachment:
+    """Connects one mechanism vibration coordinate to a frame node.
+
+    Attributes
+    ----------
+    coordinate : str
+        Name of the mechanism's vibration coordinate (e.g. ``"y_guide"``).
+    node : int or str
+        Frame node (index or single-node group). For an Assembly frame give
+        ``(part_index, node)``.
+    direction : str or array_like (6,)
+        A component name (``"uy"``) or weights of (ux, uy, uz, rx, ry, rz) (unitless for
+        a unit direction; m/rad to turn a rotation into a displacement), so that the
+        attached frame motion is ``Σ w_k u_k``.
+    stiffness : float or None
+        ``None`` for a rigid attachment; otherwise the bearing stiffness, N/m or N m/rad.
+    damping : float
+        Bearing damping, N s/m or N m s/rad (elastic attachments only).
+    """
+
+    coordinate: str
+    node: object
+    direction: object
+    stiffness: float | None = None
+    damping: float = 0.0
+
+
+@dataclass(frozen=True)
+class Mount:
+    """A rheolinear mechanism model placed in a machine.
+
+    Attributes
+    ----------
+    model : femmech.mechanisms.RheolinearModel
+        One drive; its drive angle is ``ratio * φ + phase`` (rad).
+    attachments : tuple of Attachment
+    ratio : float
+        Transmission ratio from the machine's main drive angle φ.
+    phase : float
+        Angle offset, rad (identical mechanisms working out of phase on one shaft).
+    name : str
+    """
+
+    model: object
+    attachments: tuple = ()
+    ratio: float = 1.0
+    phase: float = 0.0
+    name: str = "mechanism"
+
+
+@dataclass(frozen=True)
+class CoupledSystem:
+    """Frame plus mounted mechanisms; evaluate with :meth:`matrices`.
+
+    Attributes
+    ----------
+    frame : Superelement, Assembly or FEModel
+    mounts : tuple of Mount
+    M0, B0, K0 : ndarray or sparse (n, n)
+        Constant parts: frame mass/stiffness (zero-padded to the global size) plus the
+        bearing springs and dampers of elastic attachments.
+    projections : tuple of ndarray (n_m, n_touched)
+        ``q_m = P[:, touched] x[touched]`` for each mount.
+    touched : tuple of ndarray
+        Global coordinates each mount touches.
+    n_frame : int
+        Number of frame coordinates (the first ones).
+    labels : tuple of str
+        A label per global coordinate (``"frame 12"``, ``"cam2.q2"``).
+    """
+
+    frame: object
+    mounts: tuple
+    M0: object
+    B0: object
+    K0: object
+    projections: tuple
+    touched: tuple
+    n_frame: int
+    labels: tuple
+
+    @property
+    def n(self) -> int:
+        """Number of global coordinates."""
+        return self.M0.shape[0]
+
+    @property
+    def is_sparse(self) -> bool:
+        """True when the frame is an unreduced (sparse) model."""
+        return sp.issparse(self.M0)
+
+    def mechanism_blocks(self, phi, Omega: float = 0.0, Omega_dot: float = 0.0):
+        """Per mount: M_m, B_m, C_m (n_angles, t, t) and F_m (n_angles, t) on ``touched``.
+
+        ``phi`` (n_angles,) main drive angles, rad; ``Omega`` main drive speed, rad/s.
+        Mechanism matrices are evaluated for all angles in one call per mount.
+        """
+        phi = np.atleast_1d(np.asarray(phi, dtype=float))
+        out = []
+        for mount, P in zip(self.mounts, self.projections, strict=True):
+            angle = mount.ratio * phi + mount.phase
+            speed, accel = mount.ratio * Omega, mount.ratio * Omega_dot
+            m = mount.model
+            Mm, Bm = m.M(angle), m.B(angle, speed)
+            Cm, Fm = m.C(angle, speed, accel), m.F(angle, speed, accel)
+            out.append((_project(P, Mm), _project(P, Bm), _project(P, Cm),
+                        np.einsum("ki,ak->ai", P, Fm)))
+        return out
+
+    def matrices(self, phi: float, Omega: float = 0.0, Omega_dot: float = 0.0):
+        """Coupled M, B, C (n, n) and F (n,) at one drive angle (dense or sparse)."""
+        blocks = self.mechanism_blocks([phi], Omega, Omega_dot)
+        return assemble_at(self, blocks, 0)
+
+
+def _project(P: np.ndarray, A: np.ndarray) -> np.ndarray:
+    """``Pᵀ A P`` for a stack of matrices A (n_angles, n_m, n_m) → (n_angles, t, t)."""
+    return np.einsum("ki,akl,lj->aij", P, A, P, optimize=True)
+
+
+def assemble_at(system: CoupledSystem, blocks, index: int):
+    """Add the mechanism blocks of angle ``index`` to the constant matrices."""
+    if system.is_sparse:
+        parts = {key: [] for key in "MBC"}
+        F = np.zeros(system.n)
+        for idx, (Mm, Bm, Cm, Fm) in zip(system.touched, blocks, strict=True):
+            r, c = np.meshgrid(idx, idx, indexing="ij")
+            for key, A in zip("MBC", (Mm, Bm, Cm), strict=True):
+                parts[key].append(sp.coo_matrix((A[index].ravel(), (r.ravel(), c.ravel())),
+                                                shape=(system.n, system.n)))
+            F[idx] += Fm[index]
+        M = (system.M0 + sum(parts["M"])).tocsr()
+        B = (system.B0 + sum(parts["B"])).tocsr()
+        C = (system.K0 + sum(parts["C"])).tocsr()
+        return M, B, C, F
+    M, B, C = system.M0.copy(), system.B0.copy(), system.K0.copy()
+    F = np.zeros(system.n)
+    for idx, (Mm, Bm, Cm, Fm) in zip(system.touched, blocks, strict=True):
+        ix = np.ix_(idx, idx)
+        M[ix] += Mm[index]
+        B[ix] += Bm[index]
+        C[ix] += Cm[index]
+        F[idx] += Fm[index]
+    return M, B, C, F
+
+
+def frame_row(frame, node, direction) -> np.ndarray:
+    """Row vector L (n_frame,) with ``Σ w_k u_k(node) = L u`` for frame coordinates u."""
+    w = _weights(direction)
+    if isinstance(frame, Assembly):
+        if not (isinstance(node, tuple) and len(node) == 2):
+            raise ValueError("on an Assembly frame, give the node as (part_index, node)")
+        part, local = node
+        row_local = frame_row(frame.parts[part], local, w)
+        row = np.zeros(frame.n_dof)
+        np.add.at(row, frame.part_dofs[part], row_local)
+        return row
+    T = frame.T.tocsr()
+    node_id = _node_id(frame, node)
+    full_rows = T[DOF_PER_NODE * node_id + np.arange(DOF_PER_NODE)]
+    free_row = np.asarray(full_rows.T @ w).ravel()  # (n_free,)
+    if isinstance(frame, FEModel):
+        return free_row
+    se = frame
+    row = np.zeros(se.n_reduced)
+    row[:se.n_interface] = free_row[se.free_interface]
+    interior = free_row[se.free_interior]
+    if np.any(interior):
+        row[:se.n_interface] += interior @ se.Psi
+        row[se.n_interface:] += interior @ se.Phi
+    return row
+
+
+def _node_id(frame, node) -> int:
+    if isinstance(frame, FEModel):
+        return node_index(frame.mesh, node, "attachment")
+    if isinstance(node, (int, np.integer)) and 0 <= node < frame.n_dof // DOF_PER_NODE:
+        return int(node)
+    raise ValueError(f"attachment node {node!r}: on a Superelement give a node index"
+                     f" (0..{frame.n_dof // DOF_PER_NODE - 1})")
+
+
+def _weights(direction) -> np.ndarray:
+    if isinstance(direction, str):
+        if direction not in COMPONENTS:
+            raise ValueError(f"unknown direction {direction!r}; use one of {COMPONENTS}"
+                             " or six weights")
+        w = np.zeros(DOF_PER_NODE)
+        w[COMPONENTS.index(direction)] = 1.0
+        return w
+    w = np.asarray(direction, dtype=float)
+    if w.shape != (DOF_PER_NODE,) or not np.isfinite(w).all() or not w.any():
+        raise ValueError(f"direction must be a component name or six finite weights, not all"
+                         f" zero; got {direction!r}")
+    return w
+
+
+def frame_matrices(frame):
+    """Constant frame K and M: dense for superelements, sparse otherwise."""
+    if isinstance(frame, Superelement):
+        return frame.K, frame.M
+    if isinstance(frame, Assembly):
+        return frame.K, frame.M
+    if isinstance(frame, FEModel):
+        return frame.K_free, frame.M_free
+    raise TypeError(f"frame must be a Superelement, Assembly or FEModel, got"
+                    f" {type(frame).__name__}")
+
+
+def couple(frame, mounts) -> CoupledSystem:
+    """Build the coupled system of a frame and mounted mechanisms (primal assembly).
+
+    Parameters
+    ----------
+    frame : Superelement, Assembly or FEModel
+    mounts : sequence of Mount
+
+    Returns
+    -------
+    CoupledSystem
+
+    Raises
+    ------
+    ValueError
+        Naming the mount and coordinate for unknown coordinate names, coordinates
+        attached twice, or bad attachment nodes/directions.
+    """
+    K_frame, M_frame = frame_matrices(frame)
+    n_frame = K_frame.shape[0]
+    mounts = tuple(mounts)
+    rows_of, labels = [], [f"frame {i}" for i in range(n_frame)]
+    springs = []
+    n = n_frame
+    for mount in mounts:
+        names = list(mount.model.coordinate_names)
+        rows = [None] * len(names)
+        attached = {}
+        for att in mount.attachments:
+            if att.coordinate not in names:
+                raise ValueError(f"{mount.name}: attachment of unknown coordinate"
+                                 f" {att.coordinate!r}; the mechanism has {names}")
+            if att.coordinate in attached:
+                raise ValueError(f"{mount.name}: coordinate {att.coordinate!r} attached twice")
+            attached[att.coordinate] = att
+        for k, name in enumerate(names):
+            att = attached.get(name)
+            if att is not None and att.stiffness is None:
+                rows[k] = ("frame", frame_row(frame, att.node, att.direction))
+                continue
+            rows[k] = ("own", n)
+            labels.append(f"{mount.name}.{name}")
+            if att is not None:
+                springs.append((n, frame_row(frame, att.node, att.direction),
+                                float(att.stiffness), float(att.damping)))
+            n += 1
+        rows_of.append(rows)
+    projections, touched = [], []
+    for rows in rows_of:
+        P = np.zeros((len(rows), n))
+        for k, (kind, value) in enumerate(rows):
+            if kind == "frame":
+                P[k, :n_frame] = value
+            else:
+                P[k, value] = 1.0
+        idx = np.flatnonzero(np.any(P != 0, axis=0))
+        projections.append(P[:, idx])
+        touched.append(idx)
+    M0, B0, K0 = _constant_parts(K_frame, M_frame, n, springs)
+    return CoupledSystem(frame, mounts, M0, B0, K0, tuple(projections), tuple(touched),
+                         n_frame, tuple(labels))
+
+
+def _constant_parts(K_frame, M_frame, n, springs):
+    """Frame matrices padded to n, plus bearing springs and dampers."""
+    n_frame = K_frame.shape[0]
+    sparse = sp.issparse(K_frame)
+    pad = (lambda A: sp.block_diag([A, sp.csr_matrix((n - n_frame, n - n_frame))]).tocsr()) \
+        if sparse else (lambda A: np.pad(A, (0, n - n_frame)))
+    M0, K0 = pad(M_frame), pad(K_frame)
+    B0 = sp.csr_matrix((n, n)) if sparse else np.zeros((n, n))
+    for own, row, k, c in springs:
+        d = np.zeros(n)
+        d[own] = 1.0
+        d[:n_frame] -= row
+        idx = np.flatnonzero(d)
+        block = np.outer(d[idx], d[idx])
+        if sparse:
+            r, cidx = np.meshgrid(idx, idx, indexing="ij")
+            add = sp.coo_matrix((block.ravel(), (r.ravel(), cidx.ravel())), shape=(n, n))
+            K0 = (K0 + k * add).tocsr()
+            B0 = (B0 + c * add).tocsr()
+        else:
+            K0[np.ix_(idx, idx)] += k * block
+            B0[np.ix_(idx, idx)] += c * block
+    return M0, B0, K0

@@ -1,0 +1,228 @@
+"""Frame-mechanism coupling and quasi-mode sweeps (issue 6 core)."""
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+import sympy
+from numpy.testing import assert_allclose
+
+import femmech as fm
+from femmech import sections
+from femmech.analysis.sweep import frequency_sensitivities, frozen_modes, mac_matrix, sweep
+from femmech.coupling import Attachment, Mount, couple
+from femmech.linalg import solve_symmetric
+from femmech.mechanisms import (
+    CamProfile,
+    CamSegment,
+    Mechanism,
+    PointMass,
+    Potential,
+    RotaryInertia,
+    Spring,
+    polynomial_345,
+    position_function,
+    quasi_modes,
+    rheolinear,
+)
+from femmech.reduction import craig_bampton
+
+STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
+PARAMS = {"J1": 0.05, "m2": 3.0, "c1": 2e4, "c2": 5e5}
+CAM = CamProfile((CamSegment(np.pi / 2, 0.02, polynomial_345()), CamSegment(np.pi / 2, 0.0),
+                  CamSegment(np.pi / 2, -0.02, polynomial_345()), CamSegment(np.pi / 2, 0.0)))
+PHI = np.linspace(0.0, 2 * np.pi, 73)
+
+
+def _cam_mechanism(with_guide: bool):
+    """Table 5.1 case 1 (shaft twist q1, follower deflection q2), optionally with the
+    follower guide displacement y_g of the frame as a further coordinate:
+    x2 = y_g + U(θ + q1) + q2, 2T = J1 (θ' + q1')² + m2 x2'², 2V = c1 q1² + c2 q2²."""
+    theta, q1, yg, q2 = sympy.symbols("theta q1 y_g q2")
+    J1, m2, c1, c2 = sympy.symbols("J1 m2 c1 c2")
+    U = position_function("U")
+    x2 = (yg if with_guide else 0) + U(theta + q1) + q2
+    coords = (q1, yg, q2, theta) if with_guide else (q1, q2, theta)
+    return Mechanism(coords, (RotaryInertia(J1, theta + q1), PointMass(m2, (x2,)),
+                              Spring(c1, q1), Spring(c2, q2)), drives=(theta,))
+
+
+def _beam(E=210e9, n=40):
+    """Simply supported 1 m beam along x (uy bending carries the cam guide at mid-span)."""
+    x = np.linspace(0.0, 1.0, n + 1)
+    mesh = fm.Mesh.from_lines(np.column_stack([x, 0 * x, 0 * x]),
+                              np.column_stack([np.arange(n), np.arange(1, n + 1)]),
+                              node_sets={"ends": [0, n], "mid": [n // 2]})
+    material = fm.Material(E=E, nu=0.3, rho=7850.0)
+    prop = fm.BeamProperty(sections.rectangular_hollow(0.06, 0.08, 0.004), material)
+    return fm.build_model(mesh, {"all": prop}, supports=[
+        fm.Support("ends", "translations"), fm.Support(0, ["rx"])])
+
+
+@pytest.fixture(scope="module")
+def cam_model():
+    return rheolinear(_cam_mechanism(True), PARAMS, {"U": CAM})
+
+
+def test_rigidly_held_guide_reproduces_mechanism_alone(cam_model):
+    # Guide attached at a supported node (uy fixed): y_g = 0 exactly, so the coupled
+    # spectrum is the union of the frame's and the mechanism-alone quasi-frequencies
+    # (issue 5's quasi_modes on Table 5.1 case 1); dense LAPACK on both: round-off.
+    fe = _beam()
+    se = craig_bampton(fe, "mid", n_modes=10)
+    system = couple(se, [Mount(cam_model, (Attachment("y_g", 0, "uy"),), name="cam")])
+    alone = quasi_modes(rheolinear(_cam_mechanism(False), PARAMS, {"U": CAM}), PHI)
+    frame = np.sqrt(sla.eigh(se.K, se.M, eigvals_only=True)[:4]) / (2 * np.pi)
+    result = sweep(system, PHI, n_modes=6, track=False)
+    for a in range(PHI.size):
+        expected = np.sort(np.concatenate([alone.freq_hz[a], frame]))[:6]
+        assert_allclose(result.freq_hz[a], expected, rtol=1e-9)
+
+
+def test_stiff_frame_converges_to_mechanism_alone(cam_model):
+    # A frame 100 and 1000 times stiffer: the mechanism branches approach the
+    # mechanism-alone values with an error falling like 1/stiffness. (Much stiffer
+    # frames hit round-off: dense eigh resolves λ_min to ~eps·λ_max/λ_min ~ 1e-6 at 1e6.)
+    alone = quasi_modes(rheolinear(_cam_mechanism(False), PARAMS, {"U": CAM}), PHI[:10])
+    errors = []
+    for factor in (1e2, 1e3):
+        se = craig_bampton(_beam(E=210e9 * factor), "mid", n_modes=6)
+        system = couple(se, [Mount(cam_model, (Attachment("y_g", 20, "uy"),), name="cam")])
+        result = sweep(system, PHI[:10], n_modes=2, track=False)
+        errors.append(np.abs(result.freq_hz / alone.freq_hz[:, :2] - 1).max())
+    assert 0.05 < errors[1] / errors[0] < 0.2  # 10x stiffer, error / 10
+    assert errors[1] < 1e-3
+
+
+def test_reduced_coupled_matches_full_coupled(cam_model):
+    # Craig-Bampton (residual vectors) frame vs the unreduced FE frame in the same
+    # coupled system, at angles in dwell and rise: frequencies and mode shapes.
+    fe = _beam()
+    mount = lambda node: Mount(cam_model, (Attachment("y_g", node, "uy"),), name="cam")  # noqa: E731
+    reduced = couple(craig_bampton(fe, "mid", n_modes=10), [mount(20)])
+    full = couple(fe, [mount("mid")])
+    result = sweep(reduced, PHI, n_modes=5, keep_vectors=True, track=False)
+    for a in (0, 9, 18, 40):  # 0°, 45° (rise), 90°, 200° (return)
+        M, _, C, _ = full.matrices(PHI[a])
+        ref = solve_symmetric(C, M, n_modes=5)
+        f_ref = np.sqrt(ref.omega2) / (2 * np.pi)
+        # measured 1e-10 (the frame modes below 800 Hz are resolved to 1e-9 by CB +
+        # residual vectors); 1e-7 leaves room for the full solve's own round-off
+        assert_allclose(result.freq_hz[a], f_ref, rtol=1e-7)
+        se = reduced.frame
+        shapes = np.vstack([se.expand_free(result.vectors[a, :reduced.n_frame]),
+                            result.vectors[a, reduced.n_frame:]])
+        mac = np.diag(mac_matrix(shapes, ref.vectors, M))
+        assert mac.min() > 0.999999
+
+
+def test_elastic_attachment_tends_to_rigid(cam_model):
+    # A bearing spring k between the guide coordinate and the frame: as k grows the
+    # frequencies approach the rigid attachment's, with error ~ 1/k.
+    se = craig_bampton(_beam(), "mid", n_modes=10)
+    rigid = sweep(couple(se, [Mount(cam_model, (Attachment("y_g", 20, "uy"),))]), PHI[:5],
+                  n_modes=5, track=False).freq_hz
+    errors = []
+    for k in (1e10, 1e12):
+        system = couple(se, [Mount(cam_model, (Attachment("y_g", 20, "uy", stiffness=k),))])
+        assert system.n == couple(se, [Mount(cam_model, (Attachment("y_g", 20, "uy"),))]).n + 1
+        f = sweep(system, PHI[:5], n_modes=5, track=False).freq_hz
+        errors.append(np.abs(f / rigid - 1).max())
+    assert errors[1] < 2e-2 * errors[0]
+    assert errors[1] < 1e-6  # measured 2.3e-7 at k = 1e12 N/m
+
+
+def _two_oscillators(coupling: float):
+    """q1: constant 10 Hz-ish oscillator; q2: stiffness 1 + 0.8 U(θ) varies with the
+    angle so that its frequency crosses q1's; an optional spring couples them."""
+    theta, q1, q2 = sympy.symbols("theta q1 q2")
+    k12 = sympy.Symbol("k12")
+    U = position_function("U")
+    elements = (PointMass(1.0, (q1,)), PointMass(1.0, (q2,)), Spring(4000.0, q1),
+                Potential(sympy.Rational(1, 2) * 4000.0 * (0.6 + 0.8 * U(theta)) * q2**2),
+                Spring(k12, q1 - q2))
+    mech = Mechanism((q1, q2, theta), elements, drives=(theta,))
+    harmonic = CamProfile((CamSegment(np.pi, 1.0, polynomial_345()),
+                           CamSegment(np.pi, -1.0, polynomial_345())))
+    return rheolinear(mech, {"k12": coupling}, {"U": harmonic})
+
+
+def _oscillator_system(coupling):
+    x = np.linspace(0.0, 2.0, 5)
+    tiny = fm.Mesh.from_lines(np.column_stack([x, 0 * x, 0 * x]),
+                              [[0, 1], [1, 2], [2, 3], [3, 4]], node_sets={"a": [0], "b": [4]})
+    fe = fm.build_model(tiny, {"all": fm.BeamProperty(sections.circle(0.5), STEEL)},
+                        supports=[fm.Support("a"), fm.Support("b")])
+    se = craig_bampton(fe, [2], n_modes=0)  # a stiff frame far above the band
+    return couple(se, [Mount(_two_oscillators(coupling), name="osc")])
+
+
+def test_tracking_follows_a_crossing():
+    # Uncoupled: branch "q1" stays at sqrt(4000)/2π = 10.07 Hz while "q2" sweeps from
+    # 7.8 Hz through it to 11.9 Hz and back: tracked branches cross (their order swaps)
+    # and each keeps its frequency curve and shape (MAC step ~ 1).
+    result = sweep(_oscillator_system(0.0), PHI, n_modes=2)
+    f_q1 = np.sqrt(4000.0) / (2 * np.pi)
+    constant = np.abs(result.freq_hz - f_q1).max(axis=0) < 1e-9 * f_q1
+    assert constant.sum() == 1  # exactly one branch is the constant q1 branch
+    other = result.freq_hz[:, ~constant][:, 0]
+    assert other.min() < f_q1 < other.max()  # the other one crosses it
+    assert result.mac_step.min() > 0.999
+    untracked = sweep(_oscillator_system(0.0), PHI, n_modes=2, track=False)
+    assert np.all(np.diff(untracked.freq_hz, axis=1) >= 0)  # sorted: no branch crosses
+
+
+def test_tracking_keeps_veering_branches_apart():
+    # Weakly coupled (k12 = 100 N/m): the branches veer instead of crossing; tracked
+    # branch 0 stays the lower one at every angle, with continuous shapes.
+    result = sweep(_oscillator_system(100.0), PHI, n_modes=2)
+    assert np.all(result.freq_hz[:, 0] < result.freq_hz[:, 1])
+    gap = (result.freq_hz[:, 1] - result.freq_hz[:, 0]).min()
+    assert gap > 0.05  # the veering gap (~ k12 / (2π·2·sqrt(4000)) ~ 0.13 Hz at least)
+    assert result.mac_step.min() > 0.5
+
+
+def test_sensitivity_matches_finite_differences(cam_model):
+    # df_i/dp for the follower stiffness c2 (N/m): Fox-Kapoor formula vs central finite
+    # differences of the frequencies (step 1e-4 relative: truncation ~1e-8, round-off
+    # ~1e-12/1e-4): agreement to 1e-5 relative; a mode c2 hardly affects has df ~ 0,
+    # where the FD quotient is noise: f resolved to ~1e-12 relative over 2h = 100 N/m
+    # gives ~2e-12 Hz/(N/m), so atol = 1e-7 max|df| (5e-12).
+    se = craig_bampton(_beam(), "mid", n_modes=10)
+
+    def build(c2):
+        model = rheolinear(_cam_mechanism(True), {**PARAMS, "c2": c2}, {"U": CAM})
+        return couple(se, [Mount(model, (Attachment("y_g", 20, "uy"),))])
+
+    c2, phi = PARAMS["c2"], 0.6
+    f, df = frequency_sensitivities(build, c2, phi, n_modes=4)
+    h = 1e-4 * c2
+    fp = frozen_modes(*_mbc(build(c2 + h), phi), n_modes=4)[1]
+    fm_ = frozen_modes(*_mbc(build(c2 - h), phi), n_modes=4)[1]
+    assert_allclose(df, (fp - fm_) / (2 * h), rtol=1e-5, atol=1e-7 * np.abs(df).max())
+    assert np.abs(df).max() > 0  # c2 matters for at least one mode
+
+
+def _mbc(system, phi):
+    M, B, C, _ = system.matrices(phi)
+    return M, B, C
+
+
+def test_damped_form_reduces_to_undamped_without_damping(cam_model):
+    # With B = 0 the first-order form gives s = ±iω: the same frequencies, zero damping.
+    se = craig_bampton(_beam(), "mid", n_modes=6)
+    system = couple(se, [Mount(cam_model, (Attachment("y_g", 20, "uy"),))])
+    M, B, C, _ = system.matrices(0.4)
+    undamped = frozen_modes(M, B, C, 4)
+    damped = frozen_modes(M, 0 * B, C, 4, damped=True)
+    assert_allclose(damped[1], undamped[1], rtol=1e-8)
+    assert np.abs(damped[2]).max() < 1e-8
+
+
+def test_attachment_errors(cam_model):
+    se = craig_bampton(_beam(), "mid", n_modes=4)
+    with pytest.raises(ValueError, match="unknown coordinate 'y'"):
+        couple(se, [Mount(cam_model, (Attachment("y", 20, "uy"),), name="cam")])
+    with pytest.raises(ValueError, match="attached twice"):
+        couple(se, [Mount(cam_model, (Attachment("y_g", 20, "uy"), Attachment("y_g", 20, "uz")))])
+    with pytest.raises(ValueError, match="unknown direction"):
+        couple(se, [Mount(cam_model, (Attachment("y_g", 20, "up"),))])
