@@ -141,44 +141,32 @@ def _complete_cluster(omega2: np.ndarray, n_wanted: int, rtol: float = 1e-6) -> 
     return n
 
 
-SINGULAR_MASS_RTOL = 1e-12
-"""M counts as singular when its smallest Cholesky pivot is below this fraction of its
-largest diagonal entry (massless DOFs); the eigenproblem is then solved in the
-shift-inverted form, which drops their infinite eigenvalues."""
-
-
-def mass_is_regular(M: np.ndarray) -> bool:
-    """True when the dense symmetric M is numerically positive definite (Cholesky)."""
-    try:
-        L = np.linalg.cholesky(M)
-    except np.linalg.LinAlgError:
-        return False
-    return bool((np.diag(L) ** 2).min() > SINGULAR_MASS_RTOL * np.diag(M).max())
-
-
 def dense_symmetric(K, M, n_modes: int | None = None, sigma: float | None = None):
     """All (or the lowest ``n_modes``) eigenpairs of a dense symmetric pencil, ascending.
 
-    Uses ``scipy.linalg.eigh(K, M)`` when M is regular; with a singular M (massless
-    DOFs) it solves ``M x = μ (K - σ M) x``, ``λ = σ + 1/μ`` (σ < 0, default
-    :func:`default_shift`) and drops the infinite eigenvalues (μ ≈ 0).
+    Solves the shift-inverted pencil ``M x = μ (K - σ M) x``, ``λ = σ + 1/μ`` with
+    σ < 0 (default :func:`default_shift`) by LAPACK, like shift-invert Lanczos: the
+    lowest modes (largest μ) come out with relative accuracy ~eps however wide the
+    spectrum (``eigh(K, M)`` resolves them only to ~eps·λ_max), K may be singular
+    (rigid-body modes) and M may be singular (massless DOFs: μ = 0, infinite λ, dropped).
+    Vectors are mass-normalised (``XᵀMX = I``).
     """
     Kd = K.toarray() if sp.issparse(K) else np.asarray(K, dtype=float)
     Md = M.toarray() if sp.issparse(M) else np.asarray(M, dtype=float)
-    if mass_is_regular(Md):
-        subset = None if n_modes is None else [0, min(n_modes, len(Md)) - 1]
-        return sla.eigh(Kd, Md, subset_by_index=subset)
+    n = len(Md)
     sigma = default_shift(Kd, Md) if sigma is None else sigma
+    subset = None if n_modes is None else [n - min(n_modes, n), n - 1]
     try:
-        mu, X = sla.eigh(Md, Kd - sigma * Md)
+        mu, X = sla.eigh(Md, Kd - sigma * Md, subset_by_index=subset)
     except np.linalg.LinAlgError as exc:
         raise ValueError(
             "K - sigma*M is not positive definite: some DOF has neither stiffness nor mass"
         ) from exc
-    finite = mu > 1e-12 * np.abs(mu).max()
+    finite = mu > 1e-12 * max(np.abs(mu).max(), 1e-300)
     omega2 = sigma + 1.0 / mu[finite]
-    order = np.argsort(omega2)[:n_modes]
-    return omega2[order], X[:, finite][:, order]
+    X = X[:, finite] / np.sqrt(mu[finite])  # Xᵀ(K - σM)X = I gives XᵀMX = diag(μ)
+    order = np.argsort(omega2)
+    return omega2[order], X[:, order]
 
 
 def _arpack(K, M, k, sigma, lu, deflate=None):
@@ -259,9 +247,12 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         raise ValueError("a reused factorisation needs the shift sigma it was made with")
     shift = default_shift(K, M) if sigma is None else float(sigma)
     if n < dense_below:
-        omega2, X = dense_symmetric(K, M, sigma=shift)
-        result = _select(omega2, X, n_modes, band)
-        omega2, X = result
+        wanted = None if band is not None else n_modes + max(4, n_modes // 5)
+        omega2, X = dense_symmetric(K, M, wanted, sigma=shift)
+        if wanted is not None and omega2.size == wanted and wanted < n and \
+                _complete_cluster(omega2, n_modes) == wanted:
+            omega2, X = dense_symmetric(K, M, sigma=shift)  # a cluster fills the subset
+        omega2, X = _select(omega2, X, n_modes, band)
         method = "dense"
     elif n_modes is not None:
         omega2, X, count, cut = _sparse_lowest(K, M, n_modes, shift, factor, check)
