@@ -91,8 +91,7 @@ def frame_and_shaft(n_cams: int, per_spacing: int = 2) -> tuple[fm.FEModel, np.n
     mesh = fm.Mesh.from_lines(points, lines, cell_sets={
         "shaft": np.arange(n_sh), "base": n_sh + np.arange(n_b),
         "pedestals": n_sh + n_b + np.arange(len(pedestals))},
-        node_sets={"drive": [0], "feet": [n_x, n_x + n_x // 3, n_x + 2 * n_x // 3,
-                                            2 * n_x - 1]})
+        node_sets={"drive": [0], "feet": n_x + _feet(n_x, per_spacing)})
     beams = {
         "shaft": fm.BeamProperty(sections.circle(0.06), STEEL),
         "base": fm.BeamProperty(sections.i_section(0.2, 0.2, 0.009, 0.015), STEEL),
@@ -107,6 +106,12 @@ def frame_and_shaft(n_cams: int, per_spacing: int = 2) -> tuple[fm.FEModel, np.n
     return model, cams, n_x + cams
 
 
+def _feet(n_x: int, per_spacing: int) -> np.ndarray:
+    """Base-beam node positions of the four feet: the ends and two nodes between cams."""
+    between = lambda i: per_spacing * (i // per_spacing) + per_spacing // 2 or 1  # noqa: E731
+    return np.array([0, between(n_x // 3), between(2 * n_x // 3), n_x - 1])
+
+
 def mounts(n_cams: int, cam_nodes, guide_nodes, frame_is_reduced: bool):
     """One Mount per cam (all in phase), attached to the shaft's rx and the base's uz."""
     model = rheolinear(cam_mechanism(), PARAMS, {"U": CAM})
@@ -115,9 +120,12 @@ def mounts(n_cams: int, cam_nodes, guide_nodes, frame_is_reduced: bool):
             for i, (c, g) in enumerate(zip(cam_nodes, guide_nodes, strict=True))]
 
 
-def build(n_cams: int = 10, f_max_hz: float = 400.0):
-    """(reduced coupled system, full coupled system, FE model, superelement)."""
-    model, cams, guides = frame_and_shaft(n_cams)
+def build(n_cams: int = 10, f_max_hz: float = 400.0, per_spacing: int = 2):
+    """(reduced coupled system, full coupled system, FE model, superelement).
+
+    ``per_spacing`` elements of shaft and base beam between neighbouring cams.
+    """
+    model, cams, guides = frame_and_shaft(n_cams, per_spacing)
     interface = [(cams, ["rx"]), (guides, ["uz"])]
     se = craig_bampton(model, interface, f_max_hz=f_max_hz)
     reduced = couple(se, mounts(n_cams, cams, guides, True))

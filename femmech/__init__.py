@@ -11,7 +11,7 @@ from femmech.io import read_mesh
 from femmech.lumped import PointMass, Spring
 from femmech.materials import Material
 from femmech.mesh import Mesh
-from femmech.model import BeamProperty, FEModel, build_model
+from femmech.model import BeamProperty, FEModel, ShellProperty, ShellSet, build_model
 from femmech.sections import BeamSection
 
 __version__ = "0.1.0"
@@ -27,6 +27,8 @@ __all__ = [
     "ModeSet",
     "PointMass",
     "RigidLink",
+    "ShellProperty",
+    "ShellSet",
     "Spring",
     "Support",
     "build_model",

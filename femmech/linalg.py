@@ -15,8 +15,13 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from threadpoolctl import threadpool_limits
 
 from femmech.errors import FemmechWarning
+
+ARPACK_BLAS_THREADS = 1
+"""BLAS threads inside ARPACK's loop of triangular solves and small dense updates (None:
+leave alone). On 2 cores under load, 2 threads made such loops up to 10x slower."""
 
 MAX_DEFLATIONS = 10
 """Deflated ARPACK restarts allowed to complete a set that the Sturm count shows short."""
@@ -189,8 +194,9 @@ def _arpack(K, M, k, sigma, lu, deflate=None):
 
         v0 = v0 - deflate @ (MX.T @ v0)
     op = spla.LinearOperator((n, n), matvec=solve, dtype=float)
-    omega2, X = spla.eigsh(sp.csr_matrix(K), k=k, M=sp.csr_matrix(M), sigma=sigma,
-                           which="LM", OPinv=op, v0=v0)
+    with threadpool_limits(limits=ARPACK_BLAS_THREADS, user_api="blas"):
+        omega2, X = spla.eigsh(sp.csr_matrix(K), k=k, M=sp.csr_matrix(M), sigma=sigma,
+                               which="LM", OPinv=op, v0=v0)
     order = np.argsort(omega2)
     return omega2[order], X[:, order]
 

@@ -27,6 +27,7 @@ from femmech.constraints import (
 )
 from femmech.dofs import DOF_PER_NODE, element_dofs, node_dofs
 from femmech.elements.beam import beam_matrices, local_frames
+from femmech.elements.shell import DRILLING, shell_matrices
 from femmech.lumped import PointMass, Spring
 from femmech.materials import Material
 from femmech.mesh import Mesh
@@ -83,6 +84,53 @@ class BeamSet:
 
 
 @dataclass(frozen=True)
+class ShellProperty:
+    """Thickness and material of the shell elements (triangles, quads) of one group.
+
+    Attributes
+    ----------
+    thickness : float
+        Shell thickness, m.
+    material : Material
+    drilling : float
+        Drilling penalty ``γ / G`` tying the rotation about the shell normal to the
+        in-plane rotation (:mod:`femmech.elements.shell`); the default changes plate and
+        membrane frequencies by < 1e-4.
+    """
+
+    thickness: float
+    material: Material
+    drilling: float = DRILLING
+
+    def __post_init__(self):
+        if not isinstance(self.material, Material):
+            raise TypeError(f"ShellProperty material must be a Material,"
+                            f" got {type(self.material).__name__}")
+        t = self.thickness
+        if not (isinstance(t, (int, float, np.floating, np.integer)) and np.isfinite(t)
+                and t > 0):
+            raise ValueError(f"ShellProperty thickness must be a positive number, got {t!r}")
+        if not (np.isfinite(self.drilling) and self.drilling > 0):
+            raise ValueError(f"ShellProperty drilling must be positive, got {self.drilling!r}")
+
+
+@dataclass(frozen=True)
+class ShellSet:
+    """Shell elements of a model by cell type (``"triangle"``, ``"quad"``).
+
+    Attributes
+    ----------
+    cells : dict[str, ndarray (n_elements, 3 or 4)]
+    group : dict[str, ndarray (n_elements,) of str]
+    thickness : dict[str, ndarray (n_elements,)], m
+    """
+
+    cells: dict = field(default_factory=dict)
+    group: dict = field(default_factory=dict)
+    thickness: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
 class FEModel:
     """Assembled FE model.
 
@@ -102,6 +150,8 @@ class FEModel:
     links : ndarray (n_links, 2)
         Node pairs joined by rigid links (master, slave) or node-to-node springs, for
         drawing.
+    shells : ShellSet
+        Shell elements (empty without shell properties).
     """
 
     mesh: Mesh
@@ -114,6 +164,7 @@ class FEModel:
     links: np.ndarray
     K_free: sp.csr_matrix = field(repr=False)
     M_free: sp.csr_matrix = field(repr=False)
+    shells: ShellSet = field(default_factory=ShellSet)
 
     @property
     def n_dof(self) -> int:
@@ -137,14 +188,15 @@ class FEModel:
         return float(np.trace(e.T @ (self.M @ e)) / 3.0)
 
 
-def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(),
-                supports=(), rigid_links=(), interpolating_links=()) -> FEModel:
+def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses=(),
+                springs=(), supports=(), rigid_links=(), interpolating_links=(),
+                shells: dict[str, ShellProperty] | None = None) -> FEModel:
     """Assemble an :class:`FEModel`.
 
     Parameters
     ----------
     mesh : Mesh
-    beams : dict[str, BeamProperty]
+    beams : dict[str, BeamProperty], optional
         Cell-set name → property of its line elements; every line element needs exactly one.
     masses : sequence of PointMass
     springs : sequence of Spring
@@ -153,6 +205,10 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(
         RBE2-like links (chains allowed: a master may be the slave of another link).
     interpolating_links : sequence of InterpolatingLink
         RBE3-like links: a reference node follows the average motion of a patch.
+    shells : dict[str, ShellProperty], optional
+        Cell-set name → property of its triangle and quad cells (flat shell elements of
+        :mod:`femmech.elements.shell`, sharing nodes and DOFs with beams); every such
+        cell needs exactly one.
 
     Raises
     ------
@@ -161,13 +217,19 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(
         without or with two properties, unused nodes, coincident nodes that no spring or
         rigid link joins, zero-length elements, orientation vectors along an element.
     """
+    beams = {} if beams is None else beams
+    shells = {} if shells is None else shells
     _check_types(beams, masses, springs, supports, rigid_links, interpolating_links)
-    beam_set, Ke, Me, edofs = _beam_blocks(mesh, beams)
+    _check_shell_types(shells)
+    beam_set, Ke, Me, edofs = _beam_blocks(mesh, beams, bool(shells))
+    shell_set, shell_stiff, shell_mass = _shell_blocks(mesh, shells)
     n_dof = DOF_PER_NODE * mesh.n_nodes
-    stiff_blocks = [(edofs, Ke)]
-    mass_blocks = [(edofs, Me)]
+    stiff_blocks = [(edofs, Ke)] + shell_stiff
+    mass_blocks = [(edofs, Me)] + shell_mass
     used = np.zeros(mesh.n_nodes, dtype=bool)
     used[beam_set.cells.ravel()] = True
+    for cells in shell_set.cells.values():
+        used[cells.ravel()] = True
     joined, mass_nodes = [], []
     for item in masses:
         node = node_index(mesh, item.node, "point mass")
@@ -209,7 +271,7 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty], masses=(), springs=(
     Tt = T.T.tocsr()
     links = np.array(joined, dtype=np.int64).reshape(-1, 2)
     return FEModel(mesh, K, M, T, free, beam_set, np.array(mass_nodes, dtype=np.int64), links,
-                   (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr())
+                   (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr(), shell_set)
 
 
 def _check_types(beams, masses, springs, supports, rigid_links, interpolating_links):
@@ -233,11 +295,13 @@ def _check_types(beams, masses, springs, supports, rigid_links, interpolating_li
                             " Material")
 
 
-def _beam_blocks(mesh: Mesh, beams: dict[str, BeamProperty]):
-    unsupported = [k for k, v in mesh.cells.items() if k != "line" and len(v)]
+def _beam_blocks(mesh: Mesh, beams: dict[str, BeamProperty], with_shells: bool = False):
+    known = ("line", "triangle", "quad") if with_shells else ("line",)
+    unsupported = [k for k, v in mesh.cells.items() if k not in known and len(v)]
     if unsupported:
         raise ValueError(f"the mesh has {unsupported} cells, which have no element property;"
-                         " only line (beam) cells are supported by build_model")
+                         " build_model supports line (beam) cells and, with shell"
+                         " properties, triangle and quad (shell) cells")
     lines = mesh.cells.get("line", np.empty((0, 2), dtype=np.int64))
     owner = np.full(len(lines), -1)
     names = list(beams)
@@ -278,6 +342,68 @@ def _property_row(p: BeamProperty) -> list[float]:
     asz = s.Asz if (p.shear and s.Asz is not None) else inf
     return [m.E, m.shear_modulus, m.rho, s.A, s.Iy, s.Iz, s.J, s.polar_moment, asy, asz,
             float(p.rotary_inertia), s.draw_radius]
+
+
+def _check_shell_types(shells) -> None:
+    if not isinstance(shells, Mapping):
+        raise TypeError(f"shells must be a dict {{cell-set name: ShellProperty}},"
+                        f" got {type(shells).__name__}")
+    for name, prop in shells.items():
+        if not isinstance(prop, ShellProperty):
+            raise TypeError(f"shells[{name!r}] must be a ShellProperty,"
+                            f" got {type(prop).__name__}")
+
+
+def _shell_owner(mesh: Mesh, kind: str, names: list[str]) -> np.ndarray:
+    """Index into ``names`` of the shell group of each ``kind`` cell (checked)."""
+    cells = mesh.cells.get(kind, np.empty((0, 3 if kind == "triangle" else 4), dtype=np.int64))
+    owner = np.full(len(cells), -1)
+    for g, name in enumerate(names):
+        idx = mesh.cell_sets[name].get(kind, np.empty(0, dtype=np.int64))
+        twice = idx[owner[idx] >= 0]
+        if twice.size:
+            raise ValueError(f"{kind} element {twice[0]} is in groups"
+                             f" {names[owner[twice[0]]]!r} and {name!r}, both with shell"
+                             " properties")
+        owner[idx] = g
+    missing = np.flatnonzero(owner < 0)
+    if missing.size:
+        e = missing[0]
+        groups = [n for n, s in mesh.cell_sets.items() if e in s.get(kind, ())]
+        raise ValueError(f"{kind} element {e} (nodes {cells[e].tolist()}) has no shell"
+                         f" property ({missing.size} such elements); its groups: {groups}")
+    return owner
+
+
+def _shell_blocks(mesh: Mesh, shells: dict[str, ShellProperty]):
+    """ShellSet and (dofs, matrices) stiffness and mass blocks of the shell cells."""
+    if not shells:
+        return ShellSet(), [], []
+    names = list(shells)
+    for name in names:
+        if name not in mesh.cell_sets:
+            raise ValueError(f"shell property for unknown group {name!r};"
+                             f" the mesh has cell sets {sorted(mesh.cell_sets)}")
+        if not any(len(mesh.cell_sets[name].get(k, ())) for k in ("triangle", "quad")):
+            raise ValueError(f"shell property for group {name!r}, which has no triangle or"
+                             " quad cells")
+    table = np.array([[p.material.E, p.material.poisson_ratio, p.material.rho, p.thickness,
+                       p.drilling] for p in shells.values()])
+    cells_by, group_by, thick_by, stiff, mass = {}, {}, {}, [], []
+    for kind in ("triangle", "quad"):
+        cells = mesh.cells.get(kind)
+        if cells is None or not len(cells):
+            continue
+        owner = _shell_owner(mesh, kind, names)
+        E, nu, rho, t, drill = table[owner].T
+        Ke, Me = shell_matrices(mesh.points, cells, E, nu, rho, t, drilling=drill)
+        dofs = element_dofs(cells)
+        stiff.append((dofs, Ke))
+        mass.append((dofs, Me))
+        cells_by[kind] = cells
+        group_by[kind] = np.array(names, dtype=object)[owner]
+        thick_by[kind] = t
+    return ShellSet(cells_by, group_by, thick_by), stiff, mass
 
 
 def _orientations(mesh, lines, owner, props) -> np.ndarray:

@@ -62,3 +62,21 @@ def test_frame_example_writes_outputs(frame_run):
     for name in ("frequencies.txt", "frequencies.csv", "modes.vtu"):
         assert (out / name).stat().st_size > 0
     assert all(p.stat().st_size > 10_000 for p in result["images"])
+
+
+def test_textile_shaft_reduced_matches_full(tmp_path):
+    # Issue 6 acceptance: reduced coupled vs full coupled at 4 angles (dwell, rise,
+    # peak, return). Craig-Bampton with residual vectors resolves the frame/shaft modes
+    # in the band to ~1e-8 (measured 1.3e-8 and MAC 1 - 1e-12), so the test demands
+    # 1e-6 and MAC > 0.9999, far tighter than the issue's 0.5 % / 0.95.
+    module = _load("textile_shaft")
+    result = module.main(tmp_path, n_cams=10, n_angles=37)
+    assert result["max_error"] < 1e-6
+    assert result["min_mac"] > 0.9999
+    sweep = result["sweep"]
+    assert sweep.freq_hz.shape == (37, 6)
+    assert sweep.form == "symmetric"
+    # the cam law is periodic: the sweep closes on itself after one revolution
+    assert np.allclose(sweep.freq_hz[0], sweep.freq_hz[-1], rtol=1e-9)
+    assert (tmp_path / "quasi_frequencies.png").stat().st_size > 10_000
+    assert (tmp_path / "quasi_frequencies.csv").read_text().count("\n") == 38

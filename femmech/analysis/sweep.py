@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
+from threadpoolctl import threadpool_limits
 
 from femmech.coupling import CoupledSystem, assemble_at
 from femmech.linalg import dense_symmetric
@@ -106,7 +107,8 @@ def mac_matrix(X, Y, W=None) -> np.ndarray:
 
 def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0,
           n_modes: int = 6, damped: bool = False, track: bool = True,
-          keep_vectors: bool = False, frequency_weight: float = 0.1) -> Sweep:
+          keep_vectors: bool = False, frequency_weight: float = 0.1,
+          blas_threads: int | None = 1) -> Sweep:
     """Quasi-modes of a coupled machine at many drive angles, with mode tracking.
 
     Parameters
@@ -128,6 +130,11 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
         Store the mode shapes (n_angles, n, n_modes).
     frequency_weight : float
         Weight of the relative frequency jump against ``1 - MAC`` in the assignment.
+    blas_threads : int or None
+        BLAS threads during the per-angle solves (threadpoolctl); ``None`` leaves the
+        setting alone. Many small dense solves run fastest on one thread: on this
+        project's 2-core machine under load, 2 threads made a 271-coordinate sweep 25x
+        slower (255 vs 11 ms per angle, benchmarks/coupled_sweep.py).
 
     Returns
     -------
@@ -141,6 +148,13 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
         raise ValueError(f"n_modes must lie in 1..{system.n - 1}, got {n_modes}")
     extra = min(n_modes + max(2, n_modes // 2), system.n - (0 if damped else 1))
     blocks = system.mechanism_blocks(phi, Omega, Omega_dot)
+    with threadpool_limits(limits=blas_threads, user_api="blas"):
+        return _sweep_loop(system, phi, blocks, n_modes, extra, damped, track, keep_vectors,
+                           frequency_weight)
+
+
+def _sweep_loop(system, phi, blocks, n_modes, extra, damped, track, keep_vectors,
+                frequency_weight) -> Sweep:
     n_angles = phi.size
     lam = np.zeros((n_angles, n_modes), dtype=complex)
     freq = np.zeros((n_angles, n_modes))
