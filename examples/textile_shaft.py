@@ -35,6 +35,7 @@ from femmech import sections
 from femmech.analysis.sweep import mac_matrix, sweep
 from femmech.coupling import Attachment, Mount, couple
 from femmech.linalg import solve_symmetric
+from femmech.output.diagrams import plot_mac, write_sweep_csv, write_sweep_json
 from femmech.mechanisms import (
     CamProfile,
     CamSegment,
@@ -146,8 +147,8 @@ def compare(reduced, full, phi, n_modes: int):
         f_ref = np.sqrt(ref.omega2[:n_modes]) / (2 * np.pi)
         shapes = np.vstack([se.expand_free(result.vectors[a, :reduced.n_frame]),
                             result.vectors[a, reduced.n_frame:]])
-        mac = np.diag(mac_matrix(shapes, ref.vectors[:, :n_modes], M))
-        rows.append((angle, f_ref, result.freq_hz[a], mac))
+        mac = mac_matrix(shapes, ref.vectors[:, :n_modes], M)
+        rows.append((angle, f_ref, result.freq_hz[a], np.diag(mac), mac))
     return rows, np.array(timings)
 
 
@@ -167,10 +168,10 @@ def main(out_dir="out/textile", n_cams: int = 10, n_angles: int = 181,
     macs = np.array([r[3] for r in rows])
     plot_quasi_frequencies({"coupled (reduced)": result}, out / "quasi_frequencies.png",
                            title=f"Main shaft with {n_cams} cam mechanisms in a frame")
-    table = "angle_deg," + ",".join(f"f{i + 1}_hz" for i in range(n_modes)) + "\n"
-    table += "\n".join(f"{np.rad2deg(p):.2f}," + ",".join(f"{f:.6f}" for f in row)
-                       for p, row in zip(phi, result.freq_hz, strict=True))
-    (out / "quasi_frequencies.csv").write_text(table + "\n")
+    write_sweep_csv(result, out / "quasi_frequencies.csv")
+    write_sweep_json(result, out / "quasi_frequencies.json", {"n_cams": n_cams})
+    plot_mac(rows[1][4], out / "mac_reduced_vs_full.png", "reduced coupled modes",
+             "full coupled modes", f"MAC at φ = {np.rad2deg(check[1]):.0f}°")
     print(f"{n_cams} cams: FE model {model.n_free} free DOFs, superelement {se.n_reduced}"
           f" coordinates, coupled {reduced.n}")
     print(f"sweep of {n_angles} angles: {t_sweep:.2f} s ({1e3 * t_sweep / n_angles:.2f} ms"

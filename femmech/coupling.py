@@ -105,6 +105,10 @@ class CoupledSystem:
         Number of frame coordinates (the first ones).
     labels : tuple of str
         A label per global coordinate (``"frame 12"``, ``"cam2.q2"``).
+    H : ndarray (n_c, n) or None
+        Multiplier form only: rigid attachments as constraints ``H x = 0`` (seed 5.2.1
+        eqs. 15-21, the mechanism's base coordinate minus the frame motion); ``None`` in
+        the primal form, where they are eliminated.
     """
 
     frame: object
@@ -116,6 +120,7 @@ class CoupledSystem:
     touched: tuple
     n_frame: int
     labels: tuple
+    H: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -245,13 +250,19 @@ def frame_matrices(frame):
                     f" {type(frame).__name__}")
 
 
-def couple(frame, mounts) -> CoupledSystem:
-    """Build the coupled system of a frame and mounted mechanisms (primal assembly).
+def couple(frame, mounts, form: str = "primal") -> CoupledSystem:
+    """Build the coupled system of a frame and mounted mechanisms.
 
     Parameters
     ----------
     frame : Superelement, Assembly or FEModel
     mounts : sequence of Mount
+    form : str
+        ``"primal"``: rigidly attached coordinates are replaced by the frame motion
+        (DOF compatibility). ``"multiplier"``: every mechanism coordinate stays a global
+        coordinate and rigid attachments become constraints ``H x = 0`` with Lagrange
+        multipliers (the interface forces), the chapter's mixed form (seed 5.2.1 eq. 21);
+        both give the same quasi-modes.
 
     Returns
     -------
@@ -263,9 +274,12 @@ def couple(frame, mounts) -> CoupledSystem:
         Naming the mount and coordinate for unknown coordinate names, coordinates
         attached twice, or bad attachment nodes/directions.
     """
+    if form not in ("primal", "multiplier"):
+        raise ValueError(f"form must be 'primal' or 'multiplier', got {form!r}")
     K_frame, M_frame = frame_matrices(frame)
     n_frame = K_frame.shape[0]
     mounts = tuple(mounts)
+    constraints = []
     rows_of, labels = [], [f"frame {i}" for i in range(n_frame)]
     springs = []
     n = n_frame
@@ -282,12 +296,14 @@ def couple(frame, mounts) -> CoupledSystem:
             attached[att.coordinate] = att
         for k, name in enumerate(names):
             att = attached.get(name)
-            if att is not None and att.stiffness is None:
+            if att is not None and att.stiffness is None and form == "primal":
                 rows[k] = ("frame", frame_row(frame, att.node, att.direction))
                 continue
             rows[k] = ("own", n)
             labels.append(f"{mount.name}.{name}")
-            if att is not None:
+            if att is not None and att.stiffness is None:
+                constraints.append((n, frame_row(frame, att.node, att.direction)))
+            elif att is not None:
                 springs.append((n, frame_row(frame, att.node, att.direction),
                                 float(att.stiffness), float(att.damping)))
             n += 1
@@ -304,8 +320,14 @@ def couple(frame, mounts) -> CoupledSystem:
         projections.append(P[:, idx])
         touched.append(idx)
     M0, B0, K0 = _constant_parts(K_frame, M_frame, n, springs)
+    H = None
+    if form == "multiplier":
+        H = np.zeros((len(constraints), n))
+        for i, (own, row) in enumerate(constraints):
+            H[i, own] = 1.0
+            H[i, :n_frame] = -row
     return CoupledSystem(frame, mounts, M0, B0, K0, tuple(projections), tuple(touched),
-                         n_frame, tuple(labels))
+                         n_frame, tuple(labels), H)
 
 
 def _constant_parts(K_frame, M_frame, n, springs):

@@ -226,3 +226,18 @@ def test_attachment_errors(cam_model):
         couple(se, [Mount(cam_model, (Attachment("y_g", 20, "uy"), Attachment("y_g", 20, "uz")))])
     with pytest.raises(ValueError, match="unknown direction"):
         couple(se, [Mount(cam_model, (Attachment("y_g", 20, "up"),))])
+
+
+def test_multiplier_form_equals_primal(cam_model):
+    # Seed 5.2.1 eq. 21: keeping the guide coordinate and enforcing y_g = u_frame by a
+    # multiplier gives the same quasi-modes as eliminating it (QZ vs Cholesky-based
+    # LAPACK on the same physics: round-off, ~1e-9 relative for these pencils).
+    se = craig_bampton(_beam(), "mid", n_modes=8)
+    mount = Mount(cam_model, (Attachment("y_g", 20, "uy"),), name="cam")
+    primal = sweep(couple(se, [mount]), PHI[::6], n_modes=5, track=False)
+    system = couple(se, [mount], form="multiplier")
+    assert system.H.shape == (1, system.n)
+    mixed = sweep(system, PHI[::6], n_modes=5, track=False)
+    assert_allclose(mixed.freq_hz, primal.freq_hz, rtol=1e-8)
+    with pytest.raises(ValueError, match="form must be"):
+        couple(se, [mount], form="mixed")

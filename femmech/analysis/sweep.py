@@ -61,9 +61,16 @@ class Sweep:
     form: str
 
 
-def frozen_modes(M, B, C, n_modes: int, damped: bool = False):
-    """Lowest quasi-modes at one angle (dense): (eigenvalues, freq_hz, ratio, V, form)."""
+def frozen_modes(M, B, C, n_modes: int, damped: bool = False, H=None):
+    """Lowest quasi-modes at one angle (dense): (eigenvalues, freq_hz, ratio, V, form).
+
+    With constraints ``H x = 0`` (multiplier form), the undamped problem is solved as
+    ``[[C, Hᵀ], [H, 0]] [v; μ] = λ [[M, 0], [0, 0]] [v; μ]`` (seed 5.2.1 eq. 21 for
+    harmonic motion); μ are the interface forces of the mode.
+    """
     M, B, C = (np.asarray(A) for A in (M, B, C))
+    if H is not None and len(H):
+        return _constrained_modes(M, C, np.asarray(H), n_modes, damped)
     scale = max(np.abs(C).max(), 1e-300)
     symmetric = np.abs(C - C.T).max() <= SYMMETRY_RTOL * scale
     if damped:
@@ -88,6 +95,25 @@ def frozen_modes(M, B, C, n_modes: int, damped: bool = False):
     freq = np.sqrt(np.clip(lam.real, 0.0, None)) / (2 * np.pi)
     ratio = np.where(lam.real > 0, -lam.imag / (2 * np.abs(lam.real) + 1e-300), 0.0)
     return lam, freq, ratio, _normalise(V, M), "unsymmetric"
+
+
+def _constrained_modes(M, C, H, n_modes, damped):
+    """Quasi-modes of the multiplier form (QZ on the augmented pencil, finite λ only)."""
+    if damped:
+        raise ValueError("the multiplier form supports undamped quasi-modes; use the primal"
+                         " form for damped ones")
+    n, n_c = M.shape[0], H.shape[0]
+    A = np.block([[C, H.T], [H, np.zeros((n_c, n_c))]])
+    E = np.zeros_like(A)
+    E[:n, :n] = M
+    lam, Z = sla.eig(A, E)
+    finite = np.isfinite(lam) & (np.abs(lam) < 1e300)
+    lam, V = lam[finite], Z[:n, finite]
+    order = np.argsort(lam.real)[:n_modes]
+    lam, V = lam[order], V[:, order]
+    V = _normalise(V.real if np.abs(V.imag).max() <= 1e-12 * np.abs(V).max() else V, M)
+    freq = np.sqrt(np.clip(lam.real, 0.0, None)) / (2 * np.pi)
+    return lam, freq, np.zeros(lam.size), V, "symmetric"
 
 
 def _normalise(V, M):
@@ -164,7 +190,7 @@ def _sweep_loop(system, phi, blocks, n_modes, extra, damped, track, keep_vectors
     forms, previous = set(), None
     for a in range(n_angles):
         M, B, C, _ = assemble_at(system, blocks, a)
-        ev, f, r, V, form = frozen_modes(M, B, C, extra, damped)
+        ev, f, r, V, form = frozen_modes(M, B, C, extra, damped, system.H)
         forms.add(form)
         if track and previous is not None:
             pick, macs = _assign(previous, V, f, M, frequency_weight)
