@@ -35,7 +35,6 @@ from femmech import sections
 from femmech.analysis.sweep import mac_matrix, sweep
 from femmech.coupling import Attachment, Mount, couple
 from femmech.linalg import solve_symmetric
-from femmech.output.diagrams import plot_mac, write_sweep_csv, write_sweep_json
 from femmech.mechanisms import (
     CamProfile,
     CamSegment,
@@ -48,6 +47,7 @@ from femmech.mechanisms import (
     position_function,
     rheolinear,
 )
+from femmech.output.diagrams import plot_mac, write_sweep_csv, write_sweep_json
 from femmech.reduction import craig_bampton
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")
