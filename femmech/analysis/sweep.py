@@ -174,23 +174,67 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
         raise ValueError(f"n_modes must lie in 1..{system.n - 1}, got {n_modes}")
     extra = min(n_modes + max(2, n_modes // 2), system.n - (0 if damped else 1))
     blocks = system.mechanism_blocks(phi, Omega, Omega_dot)
+
+    def matrices(a):
+        return assemble_at(system, blocks, a)[:3]
+
     with threadpool_limits(limits=blas_threads, user_api="blas"):
-        return _sweep_loop(system, phi, blocks, n_modes, extra, damped, track, keep_vectors,
-                           frequency_weight)
+        return _sweep_loop(matrices, system.n, system.H, phi, n_modes, extra, damped, track,
+                           keep_vectors, frequency_weight)
 
 
-def _sweep_loop(system, phi, blocks, n_modes, extra, damped, track, keep_vectors,
+def parameter_sweep(system_at, values, phi: float = 0.0, n_modes: int = 6,
+                    damped: bool = False, keep_vectors: bool = False,
+                    frequency_weight: float = 0.1, blas_threads: int | None = 1) -> Sweep:
+    """Quasi-modes at a fixed drive angle over a parameter, with mode tracking.
+
+    Parameters
+    ----------
+    system_at : callable
+        ``system_at(value) -> (CoupledSystem, Omega)``: the machine and drive speed
+        (rad/s) for one parameter value, e.g. ``lambda W: (system, W)`` for a drive-speed
+        sweep or ``lambda k: (build(k), 0.0)`` for a stiffness. All systems must have the
+        same coordinates.
+    values : array_like (n_values,)
+        Parameter values in sweep order (their own unit).
+    phi : float
+        Drive angle, rad.
+    n_modes, damped, keep_vectors, frequency_weight, blas_threads
+        As in :func:`sweep`.
+
+    Returns
+    -------
+    Sweep
+        With ``phi`` holding the parameter values.
+    """
+    values = np.atleast_1d(np.asarray(values, dtype=float))
+    first, _ = system_at(values[0])
+    extra = min(n_modes + max(2, n_modes // 2), first.n - (0 if damped else 1))
+
+    def matrices(a):
+        system, Omega = system_at(values[a])
+        if system.n != first.n:
+            raise ValueError(f"parameter value {values[a]}: the system has {system.n}"
+                             f" coordinates, the first one {first.n}")
+        return system.matrices(phi, Omega)[:3]
+
+    with threadpool_limits(limits=blas_threads, user_api="blas"):
+        return _sweep_loop(matrices, first.n, first.H, values, n_modes, extra, damped, True,
+                           keep_vectors, frequency_weight)
+
+
+def _sweep_loop(matrices, n, H, phi, n_modes, extra, damped, track, keep_vectors,
                 frequency_weight) -> Sweep:
     n_angles = phi.size
     lam = np.zeros((n_angles, n_modes), dtype=complex)
     freq = np.zeros((n_angles, n_modes))
     ratio = np.zeros((n_angles, n_modes))
     mac_step = np.ones((n_angles, n_modes))
-    vectors = np.zeros((n_angles, system.n, n_modes), dtype=complex) if keep_vectors else None
+    vectors = np.zeros((n_angles, n, n_modes), dtype=complex) if keep_vectors else None
     forms, previous = set(), None
     for a in range(n_angles):
-        M, B, C, _ = assemble_at(system, blocks, a)
-        ev, f, r, V, form = frozen_modes(M, B, C, extra, damped, system.H)
+        M, B, C = matrices(a)
+        ev, f, r, V, form = frozen_modes(M, B, C, extra, damped, H)
         forms.add(form)
         if track and previous is not None:
             pick, macs = _assign(previous, V, f, M, frequency_weight)
