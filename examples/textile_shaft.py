@@ -32,9 +32,9 @@ import sympy
 
 import femmech as fm
 from femmech import sections
-from femmech.analysis.sweep import mac_matrix, sweep
+from femmech.analysis.reference import compare_coupled
+from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
-from femmech.linalg import solve_symmetric
 from femmech.mechanisms import (
     CamProfile,
     CamSegment,
@@ -134,24 +134,6 @@ def build(n_cams: int = 10, f_max_hz: float = 400.0, per_spacing: int = 2):
     return reduced, full, model, se
 
 
-def compare(reduced, full, phi, n_modes: int):
-    """Frequencies and MAC of reduced vs full coupled modes at the angles ``phi``."""
-    result = sweep(reduced, phi, n_modes=n_modes, keep_vectors=True, track=False)
-    se = reduced.frame
-    rows, timings = [], []
-    for a, angle in enumerate(phi):
-        M, _, C, _ = full.matrices(angle)
-        start = time.perf_counter()
-        ref = solve_symmetric(C, M, n_modes=n_modes)
-        timings.append(time.perf_counter() - start)
-        f_ref = np.sqrt(ref.omega2[:n_modes]) / (2 * np.pi)
-        shapes = np.vstack([se.expand_free(result.vectors[a, :reduced.n_frame]),
-                            result.vectors[a, reduced.n_frame:]])
-        mac = mac_matrix(shapes, ref.vectors[:, :n_modes], M)
-        rows.append((angle, f_ref, result.freq_hz[a], np.diag(mac), mac))
-    return rows, np.array(timings)
-
-
 def main(out_dir="out/textile", n_cams: int = 10, n_angles: int = 181,
          n_modes: int = 6) -> dict:
     """Sweep the coupled machine over one revolution; compare with the full model."""
@@ -163,23 +145,25 @@ def main(out_dir="out/textile", n_cams: int = 10, n_angles: int = 181,
     result = sweep(reduced, phi, n_modes=n_modes)
     t_sweep = time.perf_counter() - start
     check = phi[[0, n_angles // 8, n_angles // 4, n_angles // 2]]
-    rows, t_full = compare(reduced, full, check, n_modes)
-    errors = np.array([np.abs(r[2] / r[1] - 1) for r in rows])
-    macs = np.array([r[3] for r in rows])
+    comparison = compare_coupled(reduced, full, check, n_modes)
+    errors, macs = np.abs(comparison.rel_error), comparison.diag_mac
     plot_quasi_frequencies({"coupled (reduced)": result}, out / "quasi_frequencies.png",
                            title=f"Main shaft with {n_cams} cam mechanisms in a frame")
     write_sweep_csv(result, out / "quasi_frequencies.csv")
     write_sweep_json(result, out / "quasi_frequencies.json", {"n_cams": n_cams})
-    plot_mac(rows[1][4], out / "mac_reduced_vs_full.png", "reduced coupled modes",
+    (out / "reduced_vs_full.txt").write_text(comparison.table() + "\n")
+    plot_mac(comparison.mac[1], out / "mac_reduced_vs_full.png", "reduced coupled modes",
              "full coupled modes", f"MAC at φ = {np.rad2deg(check[1]):.0f}°")
     print(f"{n_cams} cams: FE model {model.n_free} free DOFs, superelement {se.n_reduced}"
           f" coordinates, coupled {reduced.n}")
     print(f"sweep of {n_angles} angles: {t_sweep:.2f} s ({1e3 * t_sweep / n_angles:.2f} ms"
-          f" per angle); full coupled ARPACK: {1e3 * t_full.mean():.1f} ms per angle")
+          f" per angle); full coupled ARPACK: {1e3 * comparison.seconds_full.mean():.1f} ms"
+          " per angle")
     print(f"reduced vs full at {len(check)} angles: max frequency error {errors.max():.2e},"
           f" min MAC {macs.min():.6f}")
     return {"sweep": result, "max_error": errors.max(), "min_mac": macs.min(),
-            "time_per_angle_reduced": t_sweep / n_angles, "time_per_angle_full": t_full.mean(),
+            "time_per_angle_reduced": t_sweep / n_angles,
+            "time_per_angle_full": comparison.seconds_full.mean(),
             "n_full": full.n, "n_reduced": reduced.n}
 
 

@@ -11,7 +11,15 @@ from femmech.io import read_mesh
 from femmech.lumped import PointMass, Spring
 from femmech.materials import Material
 from femmech.mesh import Mesh
-from femmech.model import BeamProperty, FEModel, ShellProperty, ShellSet, build_model
+from femmech.model import (
+    BeamProperty,
+    FEModel,
+    ShellProperty,
+    ShellSet,
+    SolidProperty,
+    SolidSet,
+    build_model,
+)
 from femmech.sections import BeamSection
 
 __version__ = "0.1.0"
@@ -29,6 +37,8 @@ __all__ = [
     "RigidLink",
     "ShellProperty",
     "ShellSet",
+    "SolidProperty",
+    "SolidSet",
     "Spring",
     "Support",
     "build_model",

@@ -27,10 +27,20 @@ from femmech.constraints import (
 )
 from femmech.dofs import DOF_PER_NODE, element_dofs, node_dofs
 from femmech.elements.beam import beam_matrices, local_frames
-from femmech.elements.shell import DRILLING, shell_matrices
+from femmech.elements.solid import SOLID_TYPES
 from femmech.lumped import PointMass, Spring
 from femmech.materials import Material
 from femmech.mesh import Mesh
+from femmech.parts import (
+    SHELL_TYPES,
+    ShellProperty,
+    ShellSet,
+    SolidProperty,
+    SolidSet,
+    check_part_types,
+    shell_blocks,
+    solid_parts,
+)
 from femmech.sections import BeamSection
 
 
@@ -84,53 +94,6 @@ class BeamSet:
 
 
 @dataclass(frozen=True)
-class ShellProperty:
-    """Thickness and material of the shell elements (triangles, quads) of one group.
-
-    Attributes
-    ----------
-    thickness : float
-        Shell thickness, m.
-    material : Material
-    drilling : float
-        Drilling penalty ``γ / G`` tying the rotation about the shell normal to the
-        in-plane rotation (:mod:`femmech.elements.shell`); the default changes plate and
-        membrane frequencies by < 1e-4.
-    """
-
-    thickness: float
-    material: Material
-    drilling: float = DRILLING
-
-    def __post_init__(self):
-        if not isinstance(self.material, Material):
-            raise TypeError(f"ShellProperty material must be a Material,"
-                            f" got {type(self.material).__name__}")
-        t = self.thickness
-        if not (isinstance(t, (int, float, np.floating, np.integer)) and np.isfinite(t)
-                and t > 0):
-            raise ValueError(f"ShellProperty thickness must be a positive number, got {t!r}")
-        if not (np.isfinite(self.drilling) and self.drilling > 0):
-            raise ValueError(f"ShellProperty drilling must be positive, got {self.drilling!r}")
-
-
-@dataclass(frozen=True)
-class ShellSet:
-    """Shell elements of a model by cell type (``"triangle"``, ``"quad"``).
-
-    Attributes
-    ----------
-    cells : dict[str, ndarray (n_elements, 3 or 4)]
-    group : dict[str, ndarray (n_elements,) of str]
-    thickness : dict[str, ndarray (n_elements,)], m
-    """
-
-    cells: dict = field(default_factory=dict)
-    group: dict = field(default_factory=dict)
-    thickness: dict = field(default_factory=dict)
-
-
-@dataclass(frozen=True)
 class FEModel:
     """Assembled FE model.
 
@@ -152,6 +115,12 @@ class FEModel:
         drawing.
     shells : ShellSet
         Shell elements (empty without shell properties).
+    solids : SolidSet
+        Solid elements (empty without solid properties).
+    inactive : ndarray (n_inactive,)
+        Rotational DOFs of solid nodes with neither stiffness, mass nor constraint
+        (nodes that only solid elements use); removed from ``free`` like supported DOFs,
+        but they are not supports.
     """
 
     mesh: Mesh
@@ -165,6 +134,8 @@ class FEModel:
     K_free: sp.csr_matrix = field(repr=False)
     M_free: sp.csr_matrix = field(repr=False)
     shells: ShellSet = field(default_factory=ShellSet)
+    solids: SolidSet = field(default_factory=SolidSet)
+    inactive: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))
 
     @property
     def n_dof(self) -> int:
@@ -190,7 +161,8 @@ class FEModel:
 
 def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses=(),
                 springs=(), supports=(), rigid_links=(), interpolating_links=(),
-                shells: dict[str, ShellProperty] | None = None) -> FEModel:
+                shells: dict[str, ShellProperty] | None = None,
+                solids: dict[str, SolidProperty] | None = None) -> FEModel:
     """Assemble an :class:`FEModel`.
 
     Parameters
@@ -209,6 +181,12 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
         Cell-set name → property of its triangle and quad cells (flat shell elements of
         :mod:`femmech.elements.shell`, sharing nodes and DOFs with beams); every such
         cell needs exactly one.
+    solids : dict[str, SolidProperty], optional
+        Cell-set name → property of its tetra, tetra10, hexahedron, hexahedron20 and
+        hexahedron27 cells (:mod:`femmech.elements.solid`, translations only); every such
+        cell needs exactly one. A node shared with a beam or shell couples translations
+        only; join a beam end to a patch of solid nodes with a rigid or interpolating
+        link to transmit moments (:mod:`femmech.parts`).
 
     Raises
     ------
@@ -219,16 +197,18 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
     """
     beams = {} if beams is None else beams
     shells = {} if shells is None else shells
+    solids = {} if solids is None else solids
     _check_types(beams, masses, springs, supports, rigid_links, interpolating_links)
-    _check_shell_types(shells)
-    beam_set, Ke, Me, edofs = _beam_blocks(mesh, beams, bool(shells))
-    shell_set, shell_stiff, shell_mass = _shell_blocks(mesh, shells)
+    check_part_types(shells, solids)
+    beam_set, Ke, Me, edofs = _beam_blocks(mesh, beams, bool(shells), bool(solids))
+    shell_set, shell_stiff, shell_mass = shell_blocks(mesh, shells)
     n_dof = DOF_PER_NODE * mesh.n_nodes
+    solid_set, solid_stiff, solid_mass = solid_parts(mesh, solids, n_dof)
     stiff_blocks = [(edofs, Ke)] + shell_stiff
     mass_blocks = [(edofs, Me)] + shell_mass
     used = np.zeros(mesh.n_nodes, dtype=bool)
     used[beam_set.cells.ravel()] = True
-    for cells in shell_set.cells.values():
+    for cells in (*shell_set.cells.values(), *solid_set.cells.values()):
         used[cells.ravel()] = True
     joined, mass_nodes = [], []
     for item in masses:
@@ -265,13 +245,29 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
         blocked = fixed.copy()
         blocked[eqs.dependent()] = True
         add_interpolating_link(eqs, mesh.points, reference, patch, weights, blocked, label)
-    T, free = constraint_transform(n_dof, fixed, eqs)
-    K = assemble(stiff_blocks, n_dof)
-    M = assemble(mass_blocks, n_dof)
+    K = sum(solid_stiff, assemble(stiff_blocks, n_dof)).tocsr()
+    M = sum(solid_mass, assemble(mass_blocks, n_dof)).tocsr()
+    inactive = _inactive_rotations(solid_set, K, M, eqs)
+    T, free = constraint_transform(n_dof, fixed | inactive, eqs)
     Tt = T.T.tocsr()
     links = np.array(joined, dtype=np.int64).reshape(-1, 2)
     return FEModel(mesh, K, M, T, free, beam_set, np.array(mass_nodes, dtype=np.int64), links,
-                   (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr(), shell_set)
+                   (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr(), shell_set, solid_set,
+                   np.flatnonzero(inactive))
+
+
+def _inactive_rotations(solid_set: SolidSet, K, M, eqs: EquationSet) -> np.ndarray:
+    """Mask (n_dof,) of rotations of solid nodes with zero K and M diagonals that no
+    constraint equation names (K, M are semi-definite: a zero diagonal is a zero row)."""
+    mask = np.zeros(K.shape[0], dtype=bool)
+    if not solid_set.cells:
+        return mask
+    nodes = np.unique(np.concatenate([c.ravel() for c in solid_set.cells.values()]))
+    mask[(DOF_PER_NODE * nodes[:, None] + np.arange(3, 6)).ravel()] = True
+    mask &= (K.diagonal() == 0) & (M.diagonal() == 0)
+    for part in eqs.rows + eqs.cols:
+        mask[part] = False
+    return mask
 
 
 def _check_types(beams, masses, springs, supports, rigid_links, interpolating_links):
@@ -295,13 +291,16 @@ def _check_types(beams, masses, springs, supports, rigid_links, interpolating_li
                             " Material")
 
 
-def _beam_blocks(mesh: Mesh, beams: dict[str, BeamProperty], with_shells: bool = False):
-    known = ("line", "triangle", "quad") if with_shells else ("line",)
+def _beam_blocks(mesh: Mesh, beams: dict[str, BeamProperty], with_shells: bool = False,
+                 with_solids: bool = False):
+    known = ("line",) + (SHELL_TYPES if with_shells else ()) + (SOLID_TYPES if with_solids
+                                                               else ())
     unsupported = [k for k, v in mesh.cells.items() if k not in known and len(v)]
     if unsupported:
         raise ValueError(f"the mesh has {unsupported} cells, which have no element property;"
-                         " build_model supports line (beam) cells and, with shell"
-                         " properties, triangle and quad (shell) cells")
+                         " build_model supports line (beam) cells, with shell properties"
+                         f" {SHELL_TYPES} cells and with solid properties {SOLID_TYPES}"
+                         " cells")
     lines = mesh.cells.get("line", np.empty((0, 2), dtype=np.int64))
     owner = np.full(len(lines), -1)
     names = list(beams)
@@ -342,68 +341,6 @@ def _property_row(p: BeamProperty) -> list[float]:
     asz = s.Asz if (p.shear and s.Asz is not None) else inf
     return [m.E, m.shear_modulus, m.rho, s.A, s.Iy, s.Iz, s.J, s.polar_moment, asy, asz,
             float(p.rotary_inertia), s.draw_radius]
-
-
-def _check_shell_types(shells) -> None:
-    if not isinstance(shells, Mapping):
-        raise TypeError(f"shells must be a dict {{cell-set name: ShellProperty}},"
-                        f" got {type(shells).__name__}")
-    for name, prop in shells.items():
-        if not isinstance(prop, ShellProperty):
-            raise TypeError(f"shells[{name!r}] must be a ShellProperty,"
-                            f" got {type(prop).__name__}")
-
-
-def _shell_owner(mesh: Mesh, kind: str, names: list[str]) -> np.ndarray:
-    """Index into ``names`` of the shell group of each ``kind`` cell (checked)."""
-    cells = mesh.cells.get(kind, np.empty((0, 3 if kind == "triangle" else 4), dtype=np.int64))
-    owner = np.full(len(cells), -1)
-    for g, name in enumerate(names):
-        idx = mesh.cell_sets[name].get(kind, np.empty(0, dtype=np.int64))
-        twice = idx[owner[idx] >= 0]
-        if twice.size:
-            raise ValueError(f"{kind} element {twice[0]} is in groups"
-                             f" {names[owner[twice[0]]]!r} and {name!r}, both with shell"
-                             " properties")
-        owner[idx] = g
-    missing = np.flatnonzero(owner < 0)
-    if missing.size:
-        e = missing[0]
-        groups = [n for n, s in mesh.cell_sets.items() if e in s.get(kind, ())]
-        raise ValueError(f"{kind} element {e} (nodes {cells[e].tolist()}) has no shell"
-                         f" property ({missing.size} such elements); its groups: {groups}")
-    return owner
-
-
-def _shell_blocks(mesh: Mesh, shells: dict[str, ShellProperty]):
-    """ShellSet and (dofs, matrices) stiffness and mass blocks of the shell cells."""
-    if not shells:
-        return ShellSet(), [], []
-    names = list(shells)
-    for name in names:
-        if name not in mesh.cell_sets:
-            raise ValueError(f"shell property for unknown group {name!r};"
-                             f" the mesh has cell sets {sorted(mesh.cell_sets)}")
-        if not any(len(mesh.cell_sets[name].get(k, ())) for k in ("triangle", "quad")):
-            raise ValueError(f"shell property for group {name!r}, which has no triangle or"
-                             " quad cells")
-    table = np.array([[p.material.E, p.material.poisson_ratio, p.material.rho, p.thickness,
-                       p.drilling] for p in shells.values()])
-    cells_by, group_by, thick_by, stiff, mass = {}, {}, {}, [], []
-    for kind in ("triangle", "quad"):
-        cells = mesh.cells.get(kind)
-        if cells is None or not len(cells):
-            continue
-        owner = _shell_owner(mesh, kind, names)
-        E, nu, rho, t, drill = table[owner].T
-        Ke, Me = shell_matrices(mesh.points, cells, E, nu, rho, t, drilling=drill)
-        dofs = element_dofs(cells)
-        stiff.append((dofs, Ke))
-        mass.append((dofs, Me))
-        cells_by[kind] = cells
-        group_by[kind] = np.array(names, dtype=object)[owner]
-        thick_by[kind] = t
-    return ShellSet(cells_by, group_by, thick_by), stiff, mass
 
 
 def _orientations(mesh, lines, owner, props) -> np.ndarray:

@@ -138,12 +138,13 @@ class Superelement:
 
     def expand_free(self, q: np.ndarray) -> np.ndarray:
         """Free-DOF vector(s) (n_free, ...) from reduced coordinates q (n_r, ...)."""
-        q = np.asarray(q, dtype=float)
+        q = np.asarray(q)
+        q = q.astype(np.result_type(q.dtype, float), copy=False)  # real or complex modes
         if q.shape[0] != self.n_reduced:
             raise ValueError(f"reduced vector has {q.shape[0]} rows, the superelement"
                              f" has {self.n_reduced} coordinates")
         qb, qm = q[:self.n_interface], q[self.n_interface:]
-        u = np.zeros((self.T.shape[1],) + q.shape[1:])
+        u = np.zeros((self.T.shape[1],) + q.shape[1:], dtype=q.dtype)
         u[self.free_interface] = qb
         u[self.free_interior] = np.tensordot(self.Psi, qb, 1) + np.tensordot(self.Phi, qm, 1)
         return u

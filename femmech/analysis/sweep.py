@@ -140,7 +140,8 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
     Parameters
     ----------
     system : CoupledSystem
-        With a reduced (dense) frame; for an unreduced frame use :func:`full_modes`.
+        With a reduced (dense) frame; for an unreduced frame use
+        :func:`femmech.analysis.reference.full_modes`.
     phi : array_like (n_angles,)
         Drive angles, rad, in sweep order (e.g. ``np.linspace(0, 2π, 361)``).
     Omega, Omega_dot : float
@@ -168,7 +169,8 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
     """
     if system.is_sparse:
         raise ValueError("sweep needs a reduced frame (Superelement or Assembly of"
-                         " superelements); use full_modes for an unreduced frame")
+                         " superelements); use femmech.analysis.reference.full_modes for"
+                         " an unreduced frame")
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     if not 0 < n_modes < system.n:
         raise ValueError(f"n_modes must lie in 1..{system.n - 1}, got {n_modes}")

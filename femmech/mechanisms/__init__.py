@@ -41,6 +41,7 @@ from femmech.mechanisms.motion_laws import (
     modified_trapezoid,
     polynomial_345,
 )
+from femmech.mechanisms.mounted import cam_follower, slider_crank
 from femmech.mechanisms.position import PositionFunction
 from femmech.mechanisms.quasi_modes import (
     QuasiModes,
@@ -86,6 +87,7 @@ __all__ = [
     "SliderCrank",
     "Spring",
     "TabulatedPositionFunction",
+    "cam_follower",
     "cycloidal",
     "frozen_eigen",
     "harmonic",
@@ -105,6 +107,7 @@ __all__ = [
     "rheolinear",
     "rheolinear_terms",
     "second_kind",
+    "slider_crank",
     "table_5_1_case",
     "velocity_symbol",
 ]

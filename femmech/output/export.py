@@ -20,6 +20,7 @@ import numpy as np
 from femmech.analysis.modes import ModeSet
 from femmech.dofs import DOF_PER_NODE
 from femmech.model import FEModel
+from femmech.output.surfaces import cell_blocks
 
 
 @contextmanager
@@ -77,7 +78,7 @@ def _check_sizes(model: FEModel, modes: ModeSet) -> None:
 
 
 def export_modes_vtu(model: FEModel, modes: ModeSet, filename, indices=None) -> Path:
-    """Write the beam mesh with mode shapes as point data to a VTU file for ParaView.
+    """Write the model's elements with mode shapes as point data to a VTU file for ParaView.
 
     Modes are numbered from 1 in the file (mode ``i`` is ``modes.shapes[:, i - 1]``),
     as in the titles of :func:`femmech.output.plot_mode`.
@@ -85,6 +86,7 @@ def export_modes_vtu(model: FEModel, modes: ModeSet, filename, indices=None) -> 
     Parameters
     ----------
     model : FEModel
+        Beams, shells and (when the model has ``solids``) solid elements, in any mix.
     modes : ModeSet
     filename : str or os.PathLike
         Target ``.vtu`` file; its folder must exist. Written atomically.
@@ -100,8 +102,13 @@ def export_modes_vtu(model: FEModel, modes: ModeSet, filename, indices=None) -> 
     -----
     Contents (mass-normalised shapes, so the magnitudes are in m/√kg and rad/√kg):
 
-    - cells: the beam elements as ``line`` cells; cell data ``group_id`` (int), the
-      index of the element's beam group in the sorted group names;
+    - cells: one block per element type, in this order: beams as ``line``, shells as
+      ``triangle`` and ``quad``, solids by their meshio type (``tetra``,
+      ``hexahedron``, ...); all mesh points are written (nodes used only by masses or
+      links have no cell);
+    - cell data ``group_id`` (int), the index of the element's group (beam, shell or
+      solid property group) in the sorted names of all groups, and ``thickness`` (m,
+      shells; 0 for beams and solids);
     - point data ``mode_{n}_displacement`` and ``mode_{n}_rotation``, (n_nodes, 3);
     - field data ``mode_number`` (1-based), ``frequency_hz``, ``rigid`` (0/1) for the
       written modes, in the order written, and ``group_{name}`` = [group_id] per group.
@@ -112,16 +119,21 @@ def export_modes_vtu(model: FEModel, modes: ModeSet, filename, indices=None) -> 
     """
     _check_sizes(model, modes)
     idx = _mode_indices(modes, indices)
-    names = sorted({str(g) for g in model.beams.group})
-    group_id = np.searchsorted(np.array(names, dtype=object),
-                               np.asarray(model.beams.group, dtype=object)).astype(np.int32)
+    blocks = cell_blocks(model)
+    names = sorted({str(g) for _, _, group, _ in blocks for g in group})
+    lookup = np.array(names, dtype=object)
     point_data = {}
     for i in idx:
         nodal = modes.shapes[:, i].reshape(-1, DOF_PER_NODE)
         point_data[f"mode_{i + 1}_displacement"] = nodal[:, :3].copy()
         point_data[f"mode_{i + 1}_rotation"] = nodal[:, 3:].copy()
-    mesh = meshio.Mesh(model.mesh.points, [("line", model.beams.cells)],
-                       point_data=point_data, cell_data={"group_id": [group_id]})
+    cell_data = {
+        "group_id": [np.searchsorted(lookup, np.asarray(group, dtype=str).astype(object))
+                     .astype(np.int32) for _, _, group, _ in blocks],
+        "thickness": [np.asarray(t, dtype=float) for _, _, _, t in blocks],
+    }
+    mesh = meshio.Mesh(model.mesh.points, [(kind, cells) for kind, cells, _, _ in blocks],
+                       point_data=point_data, cell_data=cell_data if blocks else {})
     field = {
         "mode_number": ("Int64", (idx + 1).astype(np.int64)),
         "frequency_hz": ("Float64", modes.freq_hz[idx].astype(float)),

@@ -5,6 +5,13 @@ Beams are drawn as tubes along the deformed curves recovered with the elements' 
 functions (:func:`femmech.recovery.beam_deflection_curves`), coloured by the
 displacement magnitude, over a grey ghost of the undeformed structure.
 
+Shells are drawn as surfaces at their mid-surface (no thickness) and solids by their
+outer surface (:mod:`femmech.output.surfaces`), deformed, coloured by the displacement
+magnitude interpolated linearly over each face, with flat shading and thin element
+edges, so that the image looks the same for any plate thickness. Their undeformed
+ghost is a grey wireframe of the outlines (free edges, plate junctions and edges
+sharper than 30 degrees). Beams, shells and solids of one model share one colour scale.
+
 Headless rendering: VTK >= 9.4 picks its OpenGL window at run time (X, then EGL, then
 OSMesa; https://docs.vtk.org/en/latest/advanced/runtime_settings.html). Without a
 display, :func:`plot_mode` sets ``VTK_DEFAULT_OPENGL_WINDOW`` to the EGL window (or to
@@ -25,6 +32,7 @@ from femmech.analysis.modes import ModeSet
 from femmech.dofs import DOF_PER_NODE
 from femmech.model import FEModel, node_index
 from femmech.output.export import _check_sizes, _mode_indices, atomic_path
+from femmech.output.surfaces import shell_cells, solid_cells, surface_faces, surface_nodes
 from femmech.recovery import beam_deflection_curves
 
 SCALE_FRACTION = 0.12
@@ -43,6 +51,8 @@ _GHOST_COLOR = "#9a9a9a"
 _FIXTURE_COLOR = "#3c3c3c"
 _MASS_COLOR = "#b2182b"
 _LINK_COLOR = "#d08c2c"  # rigid links and node-to-node springs
+_EDGE_COLOR = "#2b2b2b"
+_FEATURE_ANGLE = 30.0  # degrees: sharper edges belong to the undeformed outline
 
 
 def model_size(model: FEModel) -> float:
@@ -55,8 +65,9 @@ def mode_scale(model: FEModel, u_full: np.ndarray, n_sub: int = 8,
                fraction: float = SCALE_FRACTION) -> float:
     """Scale factor that makes the largest displacement ``fraction`` of the model size.
 
-    The largest displacement is taken along the recovered element curves (it may lie
-    between nodes). A zero shape gets scale 1.
+    The largest displacement is taken along the recovered beam curves (it may lie
+    between nodes) and over the nodes of shell and solid surfaces. A zero shape gets
+    scale 1.
 
     Parameters
     ----------
@@ -73,9 +84,19 @@ def mode_scale(model: FEModel, u_full: np.ndarray, n_sub: int = 8,
     float
         Scale factor (1/the unit of ``u_full``, times m).
     """
+    largest = _largest_displacement(model, u_full, n_sub)
+    return fraction * model_size(model) / largest if largest > 0 else 1.0
+
+
+def _largest_displacement(model: FEModel, u_full: np.ndarray, n_sub: int) -> float:
+    """Largest translation along the beam curves and at the surface nodes, m."""
     _, disp = beam_deflection_curves(model, u_full, n_sub)
     largest = float(np.linalg.norm(disp, axis=1).max()) if len(disp) else 0.0
-    return fraction * model_size(model) / largest if largest > 0 else 1.0
+    nodes = surface_nodes(model)
+    if nodes.size:
+        nodal = np.asarray(u_full, dtype=float).reshape(-1, DOF_PER_NODE)[nodes, :3]
+        largest = max(largest, float(np.linalg.norm(nodal, axis=1).max()))
+    return largest
 
 
 def mode_title(modes: ModeSet, index: int) -> str:
@@ -122,6 +143,49 @@ def mode_mesh(model: FEModel, u_full: np.ndarray, scale: float, n_sub: int = 8):
     return mesh
 
 
+def surface_mesh(model: FEModel, u_full: np.ndarray, scale: float,
+                 largest: float | None = None):
+    """Deformed shell and solid surfaces as a pyvista mesh of triangles and quads.
+
+    Parameters
+    ----------
+    model : FEModel
+    u_full : ndarray (n_dof,)
+        Full DOF vector (a mode shape), m and rad; only the translations are drawn.
+    scale : float
+        Displacement magnification.
+    largest : float, optional
+        Scaled displacement (m) that maps to magnitude 1 (default: the largest on the
+        surface), so that beams and surfaces share one colour scale.
+
+    Returns
+    -------
+    pyvista.PolyData
+        The faces of :func:`femmech.output.surfaces.surface_faces` over the surface
+        nodes only (renumbered; point data ``"node"`` holds the model node index), at
+        ``x + scale u``. Point data ``"displacement"`` (scaled, m, (n_points, 3)) and
+        ``"magnitude"`` (``|u| / largest``, 0..1); no faces for a beam model.
+    """
+    import pyvista as pv
+
+    faces = surface_faces(model)
+    nodes = surface_nodes(model)
+    new = np.full(model.mesh.n_nodes, -1, dtype=np.int64)
+    new[nodes] = np.arange(nodes.size)
+    stream = [np.column_stack([np.full(len(f), f.shape[1]), new[f]]).ravel()
+              for f in faces.values()]
+    disp = scale * np.asarray(u_full, dtype=float).reshape(-1, DOF_PER_NODE)[nodes, :3]
+    norm = np.linalg.norm(disp, axis=1)
+    if largest is None:
+        largest = float(norm.max()) if norm.size else 0.0
+    mesh = pv.PolyData(model.mesh.points[nodes] + disp,
+                       faces=np.concatenate(stream) if stream else None)
+    mesh.point_data["node"] = nodes
+    mesh.point_data["displacement"] = disp
+    mesh.point_data["magnitude"] = norm / largest if largest > 0 else norm
+    return mesh
+
+
 def _tube_radius(model: FEModel) -> np.ndarray:
     """Drawing radius per element, m, clipped to :data:`RADIUS_RANGE` of the model size."""
     low, high = RADIUS_RANGE
@@ -136,10 +200,22 @@ def _node_radius(model: FEModel) -> np.ndarray:
 
 
 def _fixed_nodes(model: FEModel) -> np.ndarray:
-    """Nodes with at least one DOF fixed by a support (an all-zero row of T)."""
+    """Nodes with at least one DOF fixed by a support (an all-zero row of T).
+
+    Nodes used only by solid elements count only their translations: their rotations
+    have no stiffness and are fixed by the model itself, not by a support.
+    """
     T = model.T.tocsr()
-    fixed_dof = np.diff(T.indptr) == 0
-    return np.flatnonzero(fixed_dof.reshape(-1, DOF_PER_NODE).any(axis=1))
+    fixed = (np.diff(T.indptr) == 0).reshape(-1, DOF_PER_NODE)
+    solids = solid_cells(model)
+    if solids:
+        solid_only = np.zeros(model.mesh.n_nodes, dtype=bool)
+        solid_only[np.concatenate([c.ravel() for c in solids.values()])] = True
+        solid_only[model.beams.cells.ravel()] = False
+        for cells in shell_cells(model).values():
+            solid_only[cells.ravel()] = False
+        fixed[solid_only, 3:] = False
+    return np.flatnonzero(fixed.any(axis=1))
 
 
 def _select_headless_backend() -> None:
@@ -192,6 +268,9 @@ def plot_mode(model: FEModel, modes: ModeSet, index: int, filename, scale: float
     -----
     Tubes follow the element curves, coloured by ``|u| / max |u|``; nodes carry spheres
     of the tube radius (clean joints) and supported nodes (any DOF fixed) dark cubes.
+    Shells and the outer surfaces of solids are drawn as flat-shaded faces with thin
+    edges (:func:`surface_mesh`) over a grey wireframe of their undeformed outlines, on
+    the same colour scale as the tubes; the drawing does not depend on shell thickness.
     The plotter has its own document theme, so the global pyvista theme does not change
     the image.
     """
@@ -276,23 +355,49 @@ def _write_png(image: np.ndarray, filename) -> None:
 
 def _add_scene(plotter, model, u, scale, n_sub, show_undeformed, mass_nodes,
                font_size) -> None:
-    """Deformed tubes with joint spheres, the undeformed ghost, supports and masses."""
+    """Beams (tubes, joints), shell/solid surfaces, their ghosts, supports, masses, links."""
     import pyvista as pv
 
-    lines = mode_mesh(model, u, scale, n_sub)
     bar = {"title": "displacement\n(relative)", "vertical": True, "n_labels": 3, "fmt": "%.1f",
            "position_x": 0.87, "position_y": 0.25, "width": 0.05, "height": 0.5,
            "color": "black", "title_font_size": font_size, "label_font_size": font_size,
            "unconstrained_font_size": True}
-    style = {"scalars": "magnitude", "cmap": _CMAP, "clim": (0.0, 1.0),
-             "smooth_shading": True, "specular": 0.3, "specular_power": 20}
+    style = {"scalars": "magnitude", "cmap": _CMAP, "clim": (0.0, 1.0)}
+    node_r = _node_radius(model)
+    marker = float(node_r.max()) if node_r.max() > 0 else RADIUS_RANGE[0] * model_size(model)
+    has_surface = surface_nodes(model).size > 0
+    largest = scale * _largest_displacement(model, u, n_sub) if has_surface else None
+    if len(model.beams.cells):
+        _add_beams(plotter, model, u, scale, n_sub, show_undeformed, style, bar, largest)
+        bar = None  # one colour bar, drawn with the first scalar mesh
+    if has_surface:
+        _add_surfaces(plotter, model, u, scale, show_undeformed, style, bar, largest)
+    displaced = model.mesh.points + scale * u.reshape(-1, DOF_PER_NODE)[:, :3]
+    _add_markers(plotter, model, displaced, mass_nodes, node_r, marker)
+    if len(model.links):
+        segments = pv.PolyData(displaced, lines=np.column_stack(
+            [np.full(len(model.links), 2), model.links]).ravel())
+        plotter.add_mesh(segments.tube(radius=0.4 * marker, n_sides=12),
+                         color=_LINK_COLOR, smooth_shading=True)
+
+
+def _add_beams(plotter, model, u, scale, n_sub, show_undeformed, style, bar, largest) -> None:
+    """Deformed tubes with joint spheres and the undeformed ghost tubes."""
+    import pyvista as pv
+
+    style = {**style, "smooth_shading": True, "specular": 0.3, "specular_power": 20}
+    lines = mode_mesh(model, u, scale, n_sub)
+    if largest is None:
+        largest = np.linalg.norm(lines.point_data["displacement"], axis=1).max()
+    elif largest > 0:  # shared with the surfaces
+        lines.point_data["magnitude"] = (np.linalg.norm(lines.point_data["displacement"], axis=1)
+                                         / largest)
     plotter.add_mesh(lines.tube(scalars="radius", absolute=True, n_sides=24, capping=True),
                      scalar_bar_args=bar, **style)
     node_r = _node_radius(model)
     nodal = scale * u.reshape(-1, DOF_PER_NODE)[:, :3]
     joints = pv.PolyData(model.mesh.points + nodal)
     joints.point_data["radius"] = node_r
-    largest = np.linalg.norm(lines.point_data["displacement"], axis=1).max()
     norm = np.linalg.norm(nodal, axis=1)
     joints.point_data["magnitude"] = norm / largest if largest > 0 else norm
     sphere = pv.Sphere(radius=1.0, theta_resolution=24, phi_resolution=16)
@@ -303,21 +408,33 @@ def _add_scene(plotter, model, u, scale, n_sub, show_undeformed, mass_nodes,
         plotter.add_mesh(ghost.tube(radius=0.35 * float(node_r.max()), n_sides=12,
                                     capping=False),
                          color=_GHOST_COLOR, opacity=0.35, smooth_shading=True)
-    _add_markers(plotter, model, joints.points, mass_nodes, node_r)
-    if len(model.links):
-        segments = pv.PolyData(joints.points, lines=np.column_stack(
-            [np.full(len(model.links), 2), model.links]).ravel())
-        plotter.add_mesh(segments.tube(radius=0.4 * float(node_r.max()), n_sides=12),
-                         color=_LINK_COLOR, smooth_shading=True)
 
 
-def _add_markers(plotter, model, displaced, mass_nodes, node_r) -> None:
-    """Dark cubes at supported nodes (undeformed), red spheres at point masses (displaced)."""
+def _add_surfaces(plotter, model, u, scale, show_undeformed, style, bar, largest) -> None:
+    """Deformed shell/solid surfaces (flat shading, thin edges) and the outline ghost."""
+    surface = surface_mesh(model, u, scale, largest)
+    plotter.add_mesh(surface, smooth_shading=False, show_edges=True, edge_color=_EDGE_COLOR,
+                     line_width=1, ambient=0.2, diffuse=0.8, specular=0.0,
+                     show_scalar_bar=bar is not None, scalar_bar_args=bar or {}, **style)
+    if show_undeformed:
+        ghost = surface_mesh(model, np.zeros_like(u), 0.0).extract_feature_edges(
+            feature_angle=_FEATURE_ANGLE, boundary_edges=True, non_manifold_edges=True,
+            feature_edges=True, manifold_edges=False)
+        plotter.add_mesh(ghost, color=_GHOST_COLOR, line_width=3, opacity=0.7)
+
+
+def _add_markers(plotter, model, displaced, mass_nodes, node_r, marker) -> None:
+    """Dark cubes at supported nodes (undeformed), red spheres at point masses (displaced).
+
+    Cubes are three times the largest tube radius at the supported nodes, or three times
+    ``marker`` (m) where no beam meets them.
+    """
     import pyvista as pv
 
     fixed = _fixed_nodes(model)
     if fixed.size:
-        edge = 3.0 * float(node_r[fixed].max())
+        radius = float(node_r[fixed].max())
+        edge = 3.0 * (radius if radius > 0 else marker)
         cube = pv.Cube(x_length=edge, y_length=edge, z_length=edge)
         cubes = pv.PolyData(model.mesh.points[fixed]).glyph(scale=False, orient=False,
                                                             geom=cube)
