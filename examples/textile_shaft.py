@@ -48,6 +48,7 @@ from femmech.mechanisms import (
     rheolinear,
 )
 from femmech.output.diagrams import plot_mac, write_sweep_csv, write_sweep_json
+from femmech.output.machine import plot_coupled_mode
 from femmech.reduction import craig_bampton
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")
@@ -142,8 +143,11 @@ def main(out_dir="out/textile", n_cams: int = 10, n_angles: int = 181,
     reduced, full, model, se = build(n_cams)
     phi = np.linspace(0.0, 2 * np.pi, n_angles)
     start = time.perf_counter()
-    result = sweep(reduced, phi, n_modes=n_modes)
+    result = sweep(reduced, phi, n_modes=n_modes, keep_vectors=True)
     t_sweep = time.perf_counter() - start
+    a = n_angles // 8  # 45°, in the cams' rise
+    plot_coupled_mode(model, reduced, result.vectors[a, :, 0], result.freq_hz[a, 0],
+                      out / "coupled_mode_1.png", angle=phi[a])
     check = phi[[0, n_angles // 8, n_angles // 4, n_angles // 2]]
     comparison = compare_coupled(reduced, full, check, n_modes)
     errors, macs = np.abs(comparison.rel_error), comparison.diag_mac

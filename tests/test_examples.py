@@ -83,4 +83,5 @@ def test_textile_shaft_reduced_matches_full(tmp_path):
     table = np.loadtxt(tmp_path / "quasi_frequencies.csv", delimiter=",", skiprows=1)
     assert np.allclose(table[:, 1:7], sweep.freq_hz, rtol=1e-9)  # written to 10 digits
     assert (tmp_path / "mac_reduced_vs_full.png").stat().st_size > 5_000
+    assert (tmp_path / "coupled_mode_1.png").stat().st_size > 10_000
     assert (tmp_path / "quasi_frequencies.json").stat().st_size > 1_000

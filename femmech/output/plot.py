@@ -232,7 +232,8 @@ def _select_headless_backend() -> None:
 
 def plot_mode(model: FEModel, modes: ModeSet, index: int, filename, scale: float | None = None,
               window_size=(1024, 768), camera=None, n_sub: int = 8,
-              show_undeformed: bool = True, masses=None) -> Path:
+              show_undeformed: bool = True, masses=None, title: str | None = None,
+              decorate=None) -> Path:
     """Render one mode shape off-screen to a PNG file.
 
     Parameters
@@ -258,6 +259,11 @@ def plot_mode(model: FEModel, modes: ModeSet, index: int, filename, scale: float
     masses : sequence of PointMass, optional
         Point masses to draw as spheres at their displaced nodes; default: all point
         masses of the model (``model.mass_nodes``).
+    title : str, optional
+        Replaces the default title (:func:`mode_title`).
+    decorate : callable, optional
+        ``decorate(plotter, scale)`` adds further actors (e.g. mechanisms drawn
+        schematically) before the camera is set.
 
     Returns
     -------
@@ -294,8 +300,10 @@ def plot_mode(model: FEModel, modes: ModeSet, index: int, filename, scale: float
     try:
         font = _font_size((k * width, k * height))
         _add_scene(plotter, model, u, scale, n_sub, show_undeformed, mass_nodes, int(1.3 * font))
-        plotter.add_text(mode_title(modes, index), position="upper_edge",
-                         font_size=font, color="black")
+        if decorate is not None:
+            decorate(plotter, scale)
+        plotter.add_text(mode_title(modes, index) if title is None else title,
+                         position="upper_edge", font_size=font, color="black")
         _set_camera(plotter, camera)
         image = plotter.screenshot(return_img=True)
     finally:
