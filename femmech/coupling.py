@@ -239,10 +239,13 @@ def _weights(direction) -> np.ndarray:
 
 
 def frame_matrices(frame):
-    """Constant frame K and M: dense for superelements, sparse otherwise."""
+    """Constant frame K and M: dense for superelements and assemblies of superelements,
+    sparse for FE models and assemblies with FE parts."""
     if isinstance(frame, Superelement):
         return frame.K, frame.M
     if isinstance(frame, Assembly):
+        if all(isinstance(p, Superelement) for p in frame.parts):
+            return frame.K.toarray(), frame.M.toarray()  # reduced: small and dense
         return frame.K, frame.M
     if isinstance(frame, FEModel):
         return frame.K_free, frame.M_free

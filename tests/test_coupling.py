@@ -260,3 +260,61 @@ def test_speed_sweep_tracks_unsymmetric_stiffness(cam_model):
     assert np.abs(np.diff(result.freq_hz, axis=0)).max() < 0.05 * result.freq_hz.min()
     assert result.mac_step.min() > 0.99
     assert np.abs(result.freq_hz[-1] - result.freq_hz[0]).max() > 1e-3  # Ω matters
+
+
+def test_free_floating_frame_keeps_rigid_body_modes(cam_model):
+    # An unsupported beam carrying the cam mechanism: nothing grounds the frame, so six
+    # quasi-frequencies are 0 (the shift-inverted dense solve handles the singular C),
+    # and the elastic ones match the unreduced coupled model (CB + residual vectors).
+    n = 20
+    x = np.linspace(0.0, 1.0, n + 1)
+    mesh = fm.Mesh.from_lines(np.column_stack([x, 0 * x, 0 * x]),
+                              np.column_stack([np.arange(n), np.arange(1, n + 1)]),
+                              node_sets={"mid": [n // 2], "ends": [0, n]})
+    prop = fm.BeamProperty(sections.rectangular_hollow(0.06, 0.08, 0.004), STEEL)
+    fe = fm.build_model(mesh, {"all": prop})
+    mount = lambda node: Mount(cam_model, (Attachment("y_g", node, "uy"),))  # noqa: E731
+    reduced = couple(craig_bampton(fe, ["mid", "ends"], n_modes=6), [mount(n // 2)])
+    result = sweep(reduced, PHI[:6], n_modes=9, track=False)
+    scale = result.freq_hz[:, 6:].min()
+    # round-off level of a zero eigenvalue: ~eps·λ_max/λ → frequency ~1e-6 of the scale
+    assert np.all(result.freq_hz[:, :6] < 1e-5 * scale)
+    from femmech.analysis.reference import full_modes
+
+    lam, _ = full_modes(couple(fe, [mount("mid")]), PHI[3], 9)
+    f_full = np.sqrt(np.clip(lam.real, 0, None)) / (2 * np.pi)
+    assert_allclose(result.freq_hz[3, 6:], f_full[6:], rtol=1e-6)
+
+
+def test_assembly_frame_equals_single_superelement(cam_model):
+    # The beam split in two superelements (assembled at the mid node) carries the
+    # mechanism at the shared node (part, node) — the same machine as one superelement
+    # of the whole beam: equal quasi-frequencies (both exact to ~1e-9 in this band).
+    from femmech.mesh import line_submesh
+    from femmech.substructures import assemble_parts
+
+    fe = _beam()
+    mesh = fe.mesh
+    left = mesh.points[mesh.cells["line"]].mean(axis=1)[:, 0] < 0.5
+    parts = []
+    for keep in (left, ~left):
+        sub, ids = line_submesh(mesh, keep)
+        node_sets = {"ends": [i for i, g in enumerate(ids) if g in (0, 40)]}
+        sub = fm.Mesh(sub.points, sub.cells, sub.cell_sets, node_sets)
+        supports = [fm.Support("ends", "translations")]
+        if 0 in ids:
+            supports.append(fm.Support(int(np.flatnonzero(ids == 0)[0]), ["rx"]))
+        part = fm.build_model(sub, {"all": fe_property()}, supports=supports)
+        cut = int(np.flatnonzero(ids == 20)[0])
+        parts.append((craig_bampton(part, [cut], n_modes=10), cut))
+    assembly = assemble_parts([se for se, _ in parts])
+    mount = Mount(cam_model, (Attachment("y_g", (0, parts[0][1]), "uy"),))
+    split = sweep(couple(assembly, [mount]), PHI[:8], n_modes=5, track=False)
+    whole = sweep(couple(craig_bampton(fe, "mid", n_modes=20),
+                         [Mount(cam_model, (Attachment("y_g", 20, "uy"),))]),
+                  PHI[:8], n_modes=5, track=False)
+    assert_allclose(split.freq_hz, whole.freq_hz, rtol=1e-6)
+
+
+def fe_property():
+    return fm.BeamProperty(sections.rectangular_hollow(0.06, 0.08, 0.004), STEEL)
