@@ -323,3 +323,24 @@ def test_beam_stiffened_plate_shares_nodes():
     # analytic uniform mode (Rayleigh, Euler-Bernoulli), 32 elements: h² error ~ 1e-3
     w_r2 = (np.pi / a)**4 * (E * t**3 * b / 12 + E * sec.Iy) / (RHO * (t * b + sec.A))
     assert_allclose(f_upper, np.sqrt(w_r2) / (2 * np.pi), rtol=3e-3)
+
+
+def test_craig_bampton_reduction_of_a_shell_plate():
+    # Reduction works on shell models like on beams: a free square plate (16 x 16 MITC4,
+    # t = 10 mm) reduced onto two corner nodes keeps its six rigid-body modes, gives
+    # upper bounds of the full elastic frequencies (Rayleigh-Ritz), and with modes up
+    # to 2x the band plus residual vectors resolves the 6 lowest elastic modes to
+    # below 0.1 % (measured 1e-8 ... 8.4e-4 with only 12 interface DOFs).
+    from femmech.analysis.modes import superelement_modes
+    from femmech.reduction import craig_bampton
+
+    mesh = plate_mesh(16)
+    model = fm.build_model(mesh, shells={"plate": fm.ShellProperty(0.01, STEEL)})
+    full = fm.modes(model, n_modes=12)
+    corners = [0, 16]
+    se = craig_bampton(model, corners, f_max_hz=full.freq_hz[11])
+    reduced = superelement_modes(se, n_modes=12, model=model)
+    assert reduced.rigid.sum() == 6
+    error = reduced.freq_hz[6:12] / full.freq_hz[6:12] - 1  # (a repeated 12th may add one)
+    assert np.all(error > -1e-9)
+    assert error.max() < 1e-3
