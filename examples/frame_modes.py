@@ -29,6 +29,7 @@ import numpy as np
 
 import femmech as fm
 from femmech import sections
+from femmech.analysis.modes import rigid_body_frequencies
 from femmech.output import export_modes_vtu, frequency_table, plot_modes, write_frequency_csv
 
 MESH = Path(__file__).resolve().parent.parent / "meshes" / "machine_frame.msh"
@@ -57,26 +58,6 @@ def build(mesh_path=MESH) -> fm.FEModel:
     )
 
 
-def rigid_body_estimate(model: fm.FEModel) -> np.ndarray:
-    """Frequencies (Hz) of the frame as a rigid body on its mounts (Rayleigh-Ritz, 6 DOF)."""
-    points = model.mesh.points
-    centre = points.mean(axis=0)
-    basis = np.zeros((model.n_dof, 6))
-    r = points - centre
-    for axis in range(3):
-        basis[axis::6, axis] = 1.0  # translations
-        e = np.eye(3)[axis]
-        rotation = np.cross(e, r)  # u = θ × r for a unit rotation about the axis
-        for comp in range(3):
-            basis[comp::6, 3 + axis] = rotation[:, comp]
-        basis[3 + axis::6, 3 + axis] = 1.0
-    Kr = basis.T @ (model.K @ basis)
-    Mr = basis.T @ (model.M @ basis)
-    import scipy.linalg
-
-    return np.sqrt(np.abs(scipy.linalg.eigvalsh(Kr, Mr))) / (2 * np.pi)
-
-
 def main(out_dir="out/frame_modes", n_modes: int = 12) -> dict:
     """Compute the modes, write table, CSV, VTU and PNG images; return key numbers."""
     out = Path(out_dir)
@@ -94,7 +75,7 @@ def main(out_dir="out/frame_modes", n_modes: int = 12) -> dict:
     print(f"wrote {len(images)} images, frequencies.txt/.csv and modes.vtu to {out}")
     return {
         "freq_hz": result.freq_hz,
-        "rigid_body_estimate_hz": rigid_body_estimate(model),
+        "rigid_body_estimate_hz": rigid_body_frequencies(model),
         "total_mass_kg": model.total_mass(),
         "n_free": model.n_free,
         "images": images,

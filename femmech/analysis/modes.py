@@ -163,3 +163,23 @@ def _mode_set(result, shapes, scale, estimate=None) -> ModeSet:
     freq = np.where(rigid, 0.0, np.sqrt(np.clip(result.omega2, 0.0, None)) / (2 * np.pi))
     return ModeSet(freq, result.omega2, shapes, rigid, result.method, result.sigma,
                    result.residual, result.sturm_count, estimate)
+
+
+def rigid_body_frequencies(model: FEModel) -> np.ndarray:
+    """Frequencies (Hz, ascending, (6,)) of the model moving as a rigid body on its springs.
+
+    Rayleigh-Ritz on the six rigid-body motions about the centroid of the nodes,
+    ``u = u_0 + θ × (x - x_c)``: the 6x6 pencil ``(Gᵀ K G, Gᵀ M G)``. By the
+    Courant-Fischer principle these are upper bounds of the six lowest eigenvalues, and
+    close to them when the structure is much stiffer than its mounts (e.g. a machine
+    frame on elastic feet). Uses the unconstrained K and M (supports are ignored).
+    """
+    import scipy.linalg
+
+    from femmech.constraints import rigid_link_matrix
+
+    points = model.mesh.points
+    G = rigid_link_matrix(points - points.mean(axis=0)).reshape(-1, 6)
+    Kr = G.T @ (model.K @ G)
+    Mr = G.T @ (model.M @ G)
+    return np.sqrt(np.abs(scipy.linalg.eigvalsh(Kr, Mr))) / (2 * np.pi)
