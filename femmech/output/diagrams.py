@@ -70,3 +70,52 @@ def write_sweep_json(sweep, filename, metadata: dict | None = None) -> Path:
     with atomic_path(filename) as tmp:
         Path(tmp).write_text(json.dumps(data, indent=1))
     return Path(filename)
+
+
+def plot_stability_chart(chart, filename, title: str = "Floquet stability",
+                         speed_label: str = "drive speed Ω (rad/s)",
+                         marks: dict | None = None) -> Path:
+    """Draw a :class:`~femmech.analysis.stability.StabilityChart` as a PNG.
+
+    With a second parameter: the (speed, parameter) plane with the unstable regions
+    (spectral radius > 1 + tol, parametric resonances) shaded and the boundary drawn.
+    Without: the spectral radius over speed (log scale) with unstable speed ranges
+    shaded. ``marks`` ({label: speed}) adds labelled vertical lines, e.g. the predicted
+    resonance speeds 2ω_k/j.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    speeds, radius = np.asarray(chart.speeds), np.asarray(chart.spectral_radius)
+    unstable = ~np.asarray(chart.stable)
+    if speeds.size < 2 or radius.shape != (radius.shape[0], speeds.size):
+        raise ValueError(f"the chart needs >= 2 speeds and radii (n_values, {speeds.size}),"
+                         f" got {speeds.size} speeds and radii {radius.shape}")
+    fig = Figure(figsize=(7.0, 4.5), dpi=120)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    if chart.values is None or len(chart.values) < 2:
+        ax.semilogy(speeds, np.maximum(radius[0], 1e-300), color="k", lw=1.2)
+        ax.axhline(1.0 + chart.tol, color="tab:red", lw=0.8, ls="--")
+        edges = np.concatenate([[speeds[0]], 0.5 * (speeds[1:] + speeds[:-1]), [speeds[-1]]])
+        for j in np.flatnonzero(unstable[0]):
+            ax.axvspan(edges[j], edges[j + 1], color="tab:red", alpha=0.25, lw=0)
+        ax.set_ylabel("spectral radius max|μ|")
+    else:
+        values = np.asarray(chart.values)
+        ax.contourf(speeds, values, unstable.astype(float), levels=[0.5, 1.5],
+                    colors=["tab:red"], alpha=0.35)
+        ax.contour(speeds, values, np.log(np.maximum(radius, 1e-300)),
+                   levels=[np.log1p(chart.tol)], colors=["tab:red"], linewidths=0.8)
+        ax.set_ylabel(chart.parameter_name)
+    for label, speed in (marks or {}).items():
+        ax.axvline(speed, color="0.3", lw=0.7, ls=":")
+        ax.annotate(str(label), (speed, 1.0), xycoords=("data", "axes fraction"),
+                    xytext=(-2, -4), textcoords="offset points", rotation=90, va="top",
+                    ha="right", fontsize=7)
+    ax.set_xlabel(speed_label)
+    ax.set_title(f"{title} (shaded: unstable)")
+    fig.tight_layout()
+    with atomic_path(filename) as tmp:
+        fig.savefig(tmp, format="png")
+    return Path(filename)
