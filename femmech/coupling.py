@@ -156,6 +156,20 @@ class CoupledSystem:
         return assemble_at(self, blocks, 0)
 
 
+def require_dense_primal(system: CoupledSystem, what: str) -> None:
+    """Raise ValueError unless ``system`` has a reduced (dense) frame and the primal form.
+
+    Time integration and monodromy need ``M(φ) q'' + B q' + C q = F`` as an ODE: the
+    multiplier form is a differential-algebraic system. ``what`` names the caller.
+    """
+    if system.is_sparse:
+        raise ValueError(f"{what} needs a reduced frame (dense matrices); reduce the frame"
+                         " with craig_bampton first")
+    if system.H is not None and len(system.H):
+        raise ValueError(f"{what} needs the primal form (the multiplier form is a"
+                         " differential-algebraic system); couple(..., form='primal')")
+
+
 def _project(P: np.ndarray, A: np.ndarray) -> np.ndarray:
     """``Pᵀ A P`` for a stack of matrices A (n_angles, n_m, n_m) → (n_angles, t, t)."""
     return np.einsum("ki,akl,lj->aij", P, A, P, optimize=True)

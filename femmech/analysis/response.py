@@ -32,7 +32,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from femmech.coupling import CoupledSystem, assemble_at, frame_row
+from femmech.coupling import CoupledSystem, assemble_at, frame_row, require_dense_primal
 from femmech.dofs import COMPONENTS, DOF_PER_NODE
 from femmech.model import node_index
 
@@ -134,12 +134,7 @@ def _drive(drive, t):
 def _matrices(system, phi, Omega, Omega_dot):
     """``matrices_at(k) -> (M, B, C, F)`` (dense) for the k-th time point."""
     if isinstance(system, CoupledSystem):
-        if system.is_sparse:
-            raise ValueError("the response needs a reduced frame (dense matrices); reduce"
-                             " the frame with craig_bampton first")
-        if system.H is not None and len(system.H):
-            raise ValueError("the response needs the primal form (the multiplier form is a"
-                             " differential-algebraic system); couple(..., form='primal')")
+        require_dense_primal(system, "the response")
         blocks = system.mechanism_blocks(phi, Omega, Omega_dot)  # one vectorised call
         return lambda k: assemble_at(system, blocks, k)
     if all(hasattr(system, name) for name in ("M", "B", "C", "F", "coordinate_names")):

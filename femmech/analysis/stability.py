@@ -44,7 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from femmech.coupling import CoupledSystem, assemble_at
+from femmech.coupling import CoupledSystem, assemble_at, require_dense_primal
 
 GAUSS_OFFSETS = np.array([0.5 - np.sqrt(3.0) / 6.0, 0.5 + np.sqrt(3.0) / 6.0])
 """Two-point Gauss-Legendre nodes on [0, 1]."""
@@ -256,12 +256,7 @@ def coupled_monodromy(system: CoupledSystem, Omega: float, n_steps: int = 256,
     ValueError
         For an unreduced (sparse) frame, the multiplier form, or Ω <= 0.
     """
-    if system.is_sparse:
-        raise ValueError("coupled_monodromy needs a reduced frame (dense matrices); reduce"
-                         " the frame with craig_bampton first")
-    if system.H is not None and len(system.H):
-        raise ValueError("coupled_monodromy needs the primal form (the multiplier form is a"
-                         " differential-algebraic system); couple(..., form='primal')")
+    require_dense_primal(system, "coupled_monodromy")
     if not (np.isfinite(Omega) and Omega > 0):
         raise ValueError(f"drive speed Omega must be positive, got {Omega} rad/s")
 
