@@ -56,6 +56,7 @@ from femmech import sections
 from femmech.dofs import element_dofs
 from femmech.elements.beam import beam_matrices
 from femmech.generators import grid_frame
+from femmech.output.export import atomic_path
 
 N_MODES = 20
 BAY = 0.5  # m
@@ -488,12 +489,17 @@ def main(sizes=("small", "medium", "large"), with_slow_reference=False,
     if echo:
         print(text)
     if out_file is not None:
-        out_file = Path(out_file)
-        out_file.parent.mkdir(parents=True, exist_ok=True)
-        tmp = out_file.with_suffix(".tmp")
-        tmp.write_text(text + "\n")
-        tmp.replace(out_file)
+        write_report(out_file, text)
     return rows
+
+
+def write_report(out_file, text: str) -> Path:
+    """Write a result table atomically (its folder is created if needed)."""
+    out_file = Path(out_file)
+    out_file.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(out_file) as tmp:
+        tmp.write_text(text + "\n")
+    return out_file
 
 
 def _cli(argv=None):

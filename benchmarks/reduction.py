@@ -52,6 +52,7 @@ import scipy.linalg as sla
 import femmech as fm
 from femmech import reduction, sections
 from femmech.generators import grid_frame
+from femmech.output.export import atomic_path
 
 N_MODES = 20
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")
@@ -292,16 +293,14 @@ def plot(full, rows, path, title="Guyan / Craig-Bampton: time vs error"):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
-    tmp = path.with_name(f".{path.stem}.tmp.png")
-    fig.savefig(tmp, dpi=120)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=120)
     plt.close(fig)
-    tmp.replace(path)
 
 
 def _write(path: Path, text: str):
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text)
-    tmp.replace(path)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text)
 
 
 # --- entry points ---------------------------------------------------------------------

@@ -187,11 +187,7 @@ def main(sizes=("small", "medium", "large"), with_slow_reference=False,
     if echo:
         print(text)
     if out_file is not None:
-        out_file = Path(out_file)
-        out_file.parent.mkdir(parents=True, exist_ok=True)
-        tmp = out_file.with_suffix(".tmp")
-        tmp.write_text(text + "\n")
-        tmp.replace(out_file)
+        fmb.write_report(out_file, text)
     return rows
 
 

@@ -29,28 +29,14 @@ from pathlib import Path
 import numpy as np
 
 from femmech.mechanisms import (
-    CamProfile,
-    CamSegment,
-    modified_sine,
-    polynomial_345,
     processing_machine,
+    processing_machine_cams,
     processing_machine_parameters,
     rheolinear,
 )
 from femmech.mechanisms.quasi_modes import plot_quasi_frequencies, quasi_modes
 
 RPM = 1200.0
-
-
-def cams() -> dict[str, CamProfile]:
-    """Return the two cam programmes (lift in m, angles in rad)."""
-    d = np.deg2rad
-    u1 = CamProfile((CamSegment(d(100), 0.05, modified_sine()), CamSegment(d(80)),
-                     CamSegment(d(100), -0.05, modified_sine()), CamSegment(d(80))))
-    u2 = CamProfile((CamSegment(d(90), 0.04, polynomial_345()), CamSegment(d(70)),
-                     CamSegment(d(90), -0.04, polynomial_345()), CamSegment(d(110))),
-                    phi_start=d(40))
-    return {"U1": u1, "U2": u2}
 
 
 def dwell_reference(p: dict[str, float]) -> np.ndarray:
@@ -74,7 +60,7 @@ def main(out_dir="out") -> dict:
         kinematic terms at 1200 rpm; ``plot`` the PNG path.
     """
     p = processing_machine_parameters(kinematic_drive=True)
-    model = rheolinear(processing_machine(kinematic_drive=True), p, cams())
+    model = rheolinear(processing_machine(kinematic_drive=True), p, processing_machine_cams())
     phi = np.deg2rad(np.linspace(0.0, 360.0, 721))
     Omega = RPM * 2 * np.pi / 60
     static = quasi_modes(model, phi)

@@ -54,12 +54,9 @@ from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
 from femmech.generators import grid_frame
 from femmech.mechanisms import (
-    CamProfile,
-    CamSegment,
-    modified_sine,
     plot_quasi_frequencies,
-    polynomial_345,
     processing_machine,
+    processing_machine_cams,
     processing_machine_parameters,
     quasi_modes,
     rheolinear,
@@ -77,17 +74,6 @@ BEARING_K = 2e8  # N/m
 DRIVE_TILT_K = 5e6  # N m/rad, tilting stiffness of the drive-end (gearbox) bearing
 DISC_MASS = (20.0, 2.0, 2.0)  # kg at the J0, J1, J2 stations
 PARAMS = processing_machine_parameters(kinematic_drive=True)
-
-
-def cams() -> dict[str, CamProfile]:
-    """The two cam programmes of examples/mechanism_quasi_modes.py (lift m, angle rad)."""
-    d = np.deg2rad
-    u1 = CamProfile((CamSegment(d(100), 0.05, modified_sine()), CamSegment(d(80)),
-                     CamSegment(d(100), -0.05, modified_sine()), CamSegment(d(80))))
-    u2 = CamProfile((CamSegment(d(90), 0.04, polynomial_345()), CamSegment(d(70)),
-                     CamSegment(d(90), -0.04, polynomial_345()), CamSegment(d(110))),
-                    phi_start=d(40))
-    return {"U1": u1, "U2": u2}
 
 
 def segment_lengths(params=PARAMS) -> np.ndarray:
@@ -162,7 +148,8 @@ def mounts(stations, brackets) -> list[Mount]:
     out = []
     for k, (U, m, c, cr, b, F) in enumerate(names):
         mech = cam_follower(U, m, c, cr, b, F, name=f"cam {U}")
-        model = rheolinear(mech, {p: PARAMS[p] for p in (m, c, cr, b, F)}, {U: cams()[U]})
+        model = rheolinear(mech, {p: PARAMS[p] for p in (m, c, cr, b, F)},
+                           {U: processing_machine_cams()[U]})
         out.append(Mount(model, (Attachment("q_s", int(stations[k + 1]), "rx"),
                                  Attachment("y_c", int(stations[k + 1]), "uz"),
                                  Attachment("y_f", int(brackets[k]), "uz")), name=f"cam{k + 1}"))
@@ -183,7 +170,7 @@ def build(f_max_hz: float = 1500.0, rigid_frame: bool = False, rho_scale: float 
 
 def mechanism_only(phi):
     """Quasi-modes of the chapter's 4-DOF model (kinematic drive, Ω = 0)."""
-    model = rheolinear(processing_machine(kinematic_drive=True), PARAMS, cams())
+    model = rheolinear(processing_machine(kinematic_drive=True), PARAMS, processing_machine_cams())
     return quasi_modes(model, phi)
 
 

@@ -114,7 +114,7 @@ def _feet(n_x: int, per_spacing: int) -> np.ndarray:
     return np.array([0, between(n_x // 3), between(2 * n_x // 3), n_x - 1])
 
 
-def mounts(n_cams: int, cam_nodes, guide_nodes, frame_is_reduced: bool):
+def mounts(cam_nodes, guide_nodes):
     """One Mount per cam (all in phase), attached to the shaft's rx and the base's uz."""
     model = rheolinear(cam_mechanism(), PARAMS, {"U": CAM})
     return [Mount(model, (Attachment("q_s", int(c), "rx"), Attachment("y_g", int(g), "uz")),
@@ -130,8 +130,8 @@ def build(n_cams: int = 10, f_max_hz: float = 400.0, per_spacing: int = 2):
     model, cams, guides = frame_and_shaft(n_cams, per_spacing)
     interface = [(cams, ["rx"]), (guides, ["uz"])]
     se = craig_bampton(model, interface, f_max_hz=f_max_hz)
-    reduced = couple(se, mounts(n_cams, cams, guides, True))
-    full = couple(model, mounts(n_cams, cams, guides, False))
+    reduced = couple(se, mounts(cams, guides))
+    full = couple(model, mounts(cams, guides))
     return reduced, full, model, se
 
 

@@ -24,11 +24,11 @@ def test_coupled_mode_image_shows_recovered_frame(tmp_path):
     reduced, full, model, se = _textile().build(4)
     result = sweep(reduced, [0.8], n_modes=3, keep_vectors=True, track=False)
     x = result.vectors[0, :, 0]
-    u = frame_shape(reduced, model, x)
+    u = frame_shape(reduced, x)
     # the recovered frame part equals the unreduced coupled mode's frame part (same
     # physics; CB + residual vectors resolve it to ~1e-6, sign fixed by a dot product)
     lam, V = full_modes(full, 0.8, 3)
-    u_full = frame_shape(full, model, V[:, 0].real)
+    u_full = frame_shape(full, V[:, 0].real)
     sign = np.sign(u @ (model.M @ u_full))
     assert_allclose(sign * u, u_full, rtol=0, atol=1e-4 * np.abs(u_full).max())
     glyphs = _mechanism_glyphs(model, reduced, x, u)

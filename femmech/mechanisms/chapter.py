@@ -18,8 +18,15 @@ drive. Examples
 (2, 2, 2)
 """
 
+import numpy as np
 import sympy
 
+from femmech.mechanisms.motion_laws import (
+    CamProfile,
+    CamSegment,
+    modified_sine,
+    polynomial_345,
+)
 from femmech.mechanisms.symbolic import (
     Damper,
     Load,
@@ -177,15 +184,31 @@ def processing_machine_parameters(kinematic_drive: bool = True) -> dict[str, flo
     """Return illustrative parameter values (SI) for :func:`processing_machine`.
 
     The chapter gives no numbers. These describe a light two-cam drive: shaft inertias
-    J1 = J2 = 2e-3 kg·m², shaft stiffnesses 2e4 N·m/rad, follower masses 3 kg on
-    follower masses 3 kg and 2 kg on follower elasticities 1e6 N/m and 6e5 N/m, return
-    springs 5e3 N/m, about 2 % damping of the follower modes.
+    J1 = J2 = 2e-3 kg·m², shaft stiffnesses 2e4 N·m/rad, follower masses 3 kg and 2 kg on
+    follower elasticities 1e6 N/m and 6e5 N/m, return springs 5e3 N/m, about 2 % damping
+    of the follower modes.
     """
     values = dict(J0=0.5, J1=2e-3, J2=2e-3, m1=3.0, m2=2.0, cT1=2e4, cT2=2e4, c3=1e6, c4=6e5,
                   c6=5e3, c7=5e3, bT1=0.2, bT2=0.2, b3=70.0, b4=70.0, F1=0.0, F2=0.0)
     if not kinematic_drive:
         values["M0"] = 0.0
     return values
+
+
+def processing_machine_cams() -> dict[str, CamProfile]:
+    """Return illustrative cam programmes U1, U2 for :func:`processing_machine` (lift m, rad).
+
+    The chapter gives none. U1: modified-sine rise of 50 mm over 100°, dwell 80°, return,
+    dwell. U2: 3-4-5 rise of 40 mm over 90°, dwell 70°, return 90°, dwell 110°, starting
+    at 40°.
+    """
+    d = np.deg2rad
+    u1 = CamProfile((CamSegment(d(100), 0.05, modified_sine()), CamSegment(d(80)),
+                     CamSegment(d(100), -0.05, modified_sine()), CamSegment(d(80))))
+    u2 = CamProfile((CamSegment(d(90), 0.04, polynomial_345()), CamSegment(d(70)),
+                     CamSegment(d(90), -0.04, polynomial_345()), CamSegment(d(110))),
+                    phi_start=d(40))
+    return {"U1": u1, "U2": u2}
 
 
 def mobile_crane() -> Mechanism:

@@ -26,7 +26,7 @@ OFFSET_FRACTION = 0.06
 """Distance of a mechanism's block from its attachment node, fraction of the model size."""
 
 
-def frame_shape(system: CoupledSystem, model: FEModel, x: np.ndarray) -> np.ndarray:
+def frame_shape(system: CoupledSystem, x: np.ndarray) -> np.ndarray:
     """Full FE displacement (n_dof,) of the frame part of a coupled vector x (n,)."""
     frame = system.frame
     x = np.real_if_close(np.asarray(x))
@@ -61,7 +61,7 @@ def plot_coupled_mode(model: FEModel, system: CoupledSystem, x: np.ndarray, freq
         default scale draws the largest of the frame and mechanism displacements as
         :data:`~femmech.output.plot.SCALE_FRACTION` of the model size.
     """
-    u = frame_shape(system, model, x)
+    u = frame_shape(system, x)
     modes = ModeSet(np.array([freq_hz]), np.array([(2 * np.pi * freq_hz) ** 2]), u[:, None],
                     np.array([False]), "coupled", 0.0, np.zeros(1), None)
     title = f"Coupled mode: {freq_hz:.2f} Hz"
