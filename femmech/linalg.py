@@ -15,13 +15,9 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from threadpoolctl import threadpool_limits
 
+from femmech import solvers, threads
 from femmech.errors import FemmechWarning
-
-ARPACK_BLAS_THREADS = 1
-"""BLAS threads inside ARPACK's loop of triangular solves and small dense updates (None:
-leave alone). On 2 cores under load, 2 threads made such loops up to 10x slower."""
 
 MAX_DEFLATIONS = 10
 """Deflated ARPACK restarts allowed to complete a set that the Sturm count shows short."""
@@ -52,6 +48,9 @@ class EigenResult:
         the number of returned eigenvalues below ``cut`` when nothing was missed.
     cut : float or None
         The bound (rad²/s²) of the Sturm check.
+    solver : str or None
+        Sparse direct solver of the shift-invert factorisation (``"superlu"``,
+        ``"cholmod"``, ``"pardiso"``, see :mod:`femmech.solvers`); None on the dense path.
     """
 
     omega2: np.ndarray
@@ -61,58 +60,75 @@ class EigenResult:
     residual: np.ndarray
     sturm_count: int | None = None
     cut: float | None = None
+    solver: str | None = None
 
 
 def eigenvalue_scale(K, M) -> float:
-    """Typical eigenvalue magnitude ``median(diag K / diag M)`` over DOFs with mass, rad²/s²."""
+    """Typical eigenvalue magnitude ``median(diag K / diag M)`` over DOFs with mass, rad²/s².
+
+    A pencil without any DOF that has both stiffness and mass (a rigid body: K vanishes on
+    every DOF with mass) has only zero finite eigenvalues; any positive scale will do for
+    it, and 1.0 is returned.
+    """
     dk = np.asarray(K.diagonal(), dtype=float)
     dm = np.asarray(M.diagonal(), dtype=float)
+    if not (dm > 0).any():
+        raise ValueError("the mass matrix has no positive diagonal entry: nothing can vibrate")
     ok = (dm > 0) & (dk > 0)
     if not ok.any():
-        raise ValueError("the mass matrix has no positive diagonal entry: nothing can vibrate")
+        return 1.0
     return float(np.median(dk[ok] / dm[ok]))
 
 
-def factorize(A, pivot_threshold: float = 0.0):
-    """Sparse LU of a symmetric matrix (SuperLU in symmetric mode), with ``solve``.
+def factorize(A, pivot_threshold: float = 0.0, definite: bool | None = None,
+              solver: str | None = None) -> solvers.Factor:
+    """Sparse factorisation of a symmetric matrix, with ``solve`` and ``n_negative``.
 
-    Uses a symmetric fill-reducing ordering (minimum degree on ``Aᵀ + A``) and diagonal
-    pivots, so the factors keep the symmetric structure: on a 120k-DOF space frame this
-    is 14x less fill and 70x faster than SuperLU's default partial pivoting (benchmarks).
+    Goes through :func:`femmech.solvers.factorize` (``solver`` default: ``"auto"``, the
+    fastest installed backend, SuperLU for small systems). SuperLU runs in symmetric
+    mode: a symmetric fill-reducing ordering (minimum degree on ``Aᵀ + A``) and diagonal
+    pivots keep the factors' symmetric structure; on a 120k-DOF space frame this is 14x
+    less fill and 70x faster than SuperLU's default partial pivoting (benchmarks).
     ``pivot_threshold = 0`` is stable for positive definite A (shift below the spectrum);
-    for an indefinite A (shift inside the spectrum) pass e.g. 0.01 so that small
-    diagonal pivots are rejected.
+    for an indefinite A (shift inside the spectrum) pass e.g. 0.01 so that SuperLU rejects
+    small diagonal pivots. ``definite`` tells the other backends whether A is positive
+    definite (True: Cholesky), may be indefinite (False: LDLᵀ) or unknown (None: try).
 
     Raises ValueError with the hint "singular" when A cannot be factorised.
     """
-    try:
-        return spla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A",
-                         diag_pivot_thresh=pivot_threshold, options={"SymmetricMode": True})
-    except RuntimeError as exc:
-        raise ValueError(f"matrix is singular and cannot be factorised ({exc})") from exc
+    return solvers.factorize(A, solver=solver, definite=definite,
+                             pivot_threshold=pivot_threshold)
 
 
 def inertia_below(K, M, cut: float) -> int | None:
     """Number of eigenvalues of ``K x = λ M x`` below ``cut`` (Sylvester's law of inertia).
 
     Counts negative pivots of a symmetric ``L D Lᵀ``-like factorisation of ``K - cut M``
-    (SuperLU in symmetric mode with diagonal pivoting). Returns None where the
-    factorisation pivoted off the diagonal, so that the count would not be the inertia.
+    (:attr:`femmech.solvers.Factor.n_negative`: SuperLU in symmetric mode with diagonal
+    pivoting, CHOLMOD's LDLᵀ, PARDISO's ``iparm(23)``). Returns None where the
+    factorisation pivoted off the diagonal (or perturbed pivots), so that the count would
+    not be the inertia.
     """
     try:
-        lu = factorize(K - cut * M)
+        lu = factorize(K - cut * M, definite=False)
     except ValueError:
         return None
-    if not np.array_equal(lu.perm_r, lu.perm_c):
-        return None
-    return int(np.count_nonzero(lu.U.diagonal() < 0))
+    return lu.n_negative
 
 
 def normalize_modes(vectors: np.ndarray, M) -> np.ndarray:
-    """Mass-normalise columns and make the largest-magnitude entry of each positive."""
+    """Mass-normalise columns and make the largest-magnitude entry of each positive.
+
+    Entries within 1e-6 of the largest magnitude count as ties and the last of them (the
+    highest DOF index) decides: symmetric structures have pairs of equal and opposite
+    largest entries, and picking the larger by round-off flipped a plate's mode (and its
+    reference picture, tests/images/plate_mode1.png) when only the shift changed.
+    """
     norms = np.sqrt(np.einsum("ij,ij->j", vectors, M @ vectors))
     vectors = vectors / norms
-    rows = np.argmax(np.abs(vectors), axis=0)
+    magnitude = np.abs(vectors)
+    near = magnitude >= (1 - 1e-6) * magnitude.max(axis=0)
+    rows = len(near) - 1 - np.argmax(near[::-1], axis=0)
     signs = np.sign(vectors[rows, np.arange(vectors.shape[1])])
     return vectors * np.where(signs == 0, 1.0, signs)
 
@@ -181,8 +197,19 @@ def _arpack(K, M, k, sigma, lu, deflate=None):
     start vector and of every operator application (``P (K - σM)⁻¹`` with
     ``P = I - X Xᵀ M``), so the run finds further members of a repeated eigenvalue that a
     single Krylov sequence cannot see.
+
+    The Krylov space of ``(K - σM)⁻¹ M`` has at most as many dimensions as M has DOFs
+    with mass (a singular M: massless DOFs), less the deflated vectors; ARPACK's
+    basis size ``ncv`` (and k below it) is capped there, where the default
+    ``max(2k + 1, 20)`` made ARPACK stop with "could not build an Arnoldi factorization".
     """
     n = K.shape[0]
+    krylov = _n_mass(M) - (0 if deflate is None else deflate.shape[1])
+    k = min(k, krylov - 1)
+    if k < 1:
+        raise ValueError(f"no further finite eigenvalue: only {_n_mass(M)} of the {n} DOFs"
+                         " carry mass")
+    ncv = min(n, max(2 * k + 1, 20), krylov)
     v0 = np.random.default_rng(12345).standard_normal(n)
     solve = lu.solve
     if deflate is not None and deflate.shape[1]:
@@ -194,11 +221,26 @@ def _arpack(K, M, k, sigma, lu, deflate=None):
 
         v0 = v0 - deflate @ (MX.T @ v0)
     op = spla.LinearOperator((n, n), matvec=solve, dtype=float)
-    with threadpool_limits(limits=ARPACK_BLAS_THREADS, user_api="blas"):
+    with threads.solve_phase():  # a loop of solves: 1 BLAS thread (femmech.threads)
         omega2, X = spla.eigsh(sp.csr_matrix(K), k=k, M=sp.csr_matrix(M), sigma=sigma,
-                               which="LM", OPinv=op, v0=v0)
+                               which="LM", OPinv=op, v0=v0, ncv=ncv)
+    if krylov + (0 if deflate is None else deflate.shape[1]) < n:
+        X = _purify(X, omega2, sigma, M, solve)
     order = np.argsort(omega2)
     return omega2[order], X[:, order]
+
+
+def _purify(X, omega2, sigma, M, solve):
+    """One operator step ``x ← (λ - σ) (K - σM)⁻¹ M x`` for a singular M (massless DOFs).
+
+    Lanczos vectors are M-orthonormal, and M does not see components in its null space:
+    the computed eigenvectors carry such components unchecked (measured residuals of 1e46
+    and more on a lumped-mass beam). One step of the operator removes them and leaves
+    true eigenvectors unchanged (B. Nour-Omid, B. N. Parlett, T. Ericsson, P. S. Jensen,
+    "How to implement the spectral transformation", Math. Comp. 48 (1987) 663-673).
+    """
+    MX = M @ X
+    return np.column_stack([solve(MX[:, j]) for j in range(X.shape[1])]) * (omega2 - sigma)
 
 
 def _merge(omega2, X, more_omega2, more_X):
@@ -207,14 +249,44 @@ def _merge(omega2, X, more_omega2, more_X):
     return omega2[order], np.hstack([X, more_X])[:, order]
 
 
-def default_shift(K, M) -> float:
-    """Shift below zero, ``-1e-6`` times :func:`eigenvalue_scale`, for modes from zero."""
-    return -1e-6 * eigenvalue_scale(K, M)
+def default_shift(K, M, scale: float | None = None) -> float:
+    """Shift below zero, ``-1e-6`` times ``scale`` (default :func:`eigenvalue_scale`)."""
+    return -1e-6 * (eigenvalue_scale(K, M) if scale is None else scale)
+
+
+def _n_mass(M) -> int:
+    """DOFs with positive mass diagonal: an upper bound of rank(M) (M is semi-definite, so a
+    zero diagonal entry is a zero row) and of the number of finite eigenvalues."""
+    return int(np.count_nonzero(np.asarray(M.diagonal()) > 0))
+
+
+def _check_request(n, n_mass, n_modes, band, sigma, factor, scale):
+    """ValueError/TypeError naming the bad argument of :func:`solve_symmetric`."""
+    if (n_modes is None) == (band is None):
+        raise ValueError("give exactly one of n_modes and band")
+    if n_modes is not None:
+        if isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer)):
+            raise TypeError(f"n_modes must be an integer, got {n_modes!r}")
+        if not 0 < n_modes <= n:
+            raise ValueError(f"n_modes must lie in 1..{n} (the number of free DOFs),"
+                             f" got {n_modes}")
+        if n_modes > n_mass:
+            raise ValueError(f"n_modes={n_modes}, but only {n_mass} of the {n} DOFs carry"
+                             " mass: massless DOFs have infinite eigenvalues, which are"
+                             f" never returned; ask for at most {n_mass} modes")
+    if band is not None and not (np.isfinite(band).all() and band[0] < band[1]):
+        raise ValueError(f"band must be finite (low, high) with low < high, got {band}")
+    if sigma is not None and not np.isfinite(sigma):
+        raise ValueError(f"sigma must be a finite shift, got {sigma}")
+    if scale is not None and not (np.isfinite(scale) and scale > 0):
+        raise ValueError(f"scale must be a positive eigenvalue magnitude, got {scale}")
+    if factor is not None and sigma is None:
+        raise ValueError("a reused factorisation needs the shift sigma it was made with")
 
 
 def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] | None = None,
                     sigma: float | None = None, dense_below: int = DENSE_BELOW,
-                    check: bool = True, factor=None) -> EigenResult:
+                    check: bool = True, factor=None, scale: float | None = None) -> EigenResult:
     """Lowest eigenpairs, or all eigenpairs in a band, of ``K x = λ M x``.
 
     Parameters
@@ -237,21 +309,26 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
     factor : object with ``solve``, optional
         A factorisation of ``K - sigma M`` to reuse (``sigma`` must then be given), e.g.
         the ``K_ii`` factorisation of a Craig-Bampton reduction with ``sigma = 0``.
+    scale : float, optional
+        Typical eigenvalue magnitude, rad²/s², for the default shift (``-1e-6 scale``),
+        the floor of the relative residuals and the Sturm cut; default
+        :func:`eigenvalue_scale`. Give it when the diagonal of K does not show it, e.g.
+        a K that is round-off only (a rigid body assembled from stiff elements).
 
     Returns
     -------
     EigenResult
+
+    Raises
+    ------
+    ValueError, TypeError
+        Naming the argument: both or neither of n_modes and band, n_modes not an integer
+        in 1..n or above the number of DOFs with mass, a band or shift that is not finite.
     """
-    if (n_modes is None) == (band is None):
-        raise ValueError("give exactly one of n_modes and band")
     n = K.shape[0]
-    if n_modes is not None and not 0 < n_modes <= n:
-        raise ValueError(f"n_modes must lie in 1..{n} (the number of free DOFs), got {n_modes}")
-    if band is not None and not band[0] < band[1]:
-        raise ValueError(f"band must be (low, high) with low < high, got {band}")
-    if factor is not None and sigma is None:
-        raise ValueError("a reused factorisation needs the shift sigma it was made with")
-    shift = default_shift(K, M) if sigma is None else float(sigma)
+    _check_request(n, _n_mass(M), n_modes, band, sigma, factor, scale)
+    scale = eigenvalue_scale(K, M) if scale is None else float(scale)
+    shift = -1e-6 * scale if sigma is None else float(sigma)
     if n < dense_below:
         wanted = None if band is not None else n_modes + max(4, n_modes // 5)
         omega2, X = dense_symmetric(K, M, wanted, sigma=shift)
@@ -261,23 +338,25 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         omega2, X = _select(omega2, X, n_modes, band)
         method = "dense"
     elif n_modes is not None:
-        omega2, X, count, cut = _sparse_lowest(K, M, n_modes, shift, factor, check)
+        omega2, X, count, cut = _sparse_lowest(K, M, n_modes, shift, factor, check, scale)
         method = "arpack"
     else:
         omega2, X, shift = _sparse_band(K, M, band, sigma, factor)
         method = "arpack"
     X = normalize_modes(X, M)
-    res = residuals(K, M, omega2, X, abs(default_shift(K, M)))
+    res = residuals(K, M, omega2, X, 1e-6 * scale)
     if res.size and res.max() > 1e-6:
         warnings.warn(f"eigen solve: largest relative residual {res.max():.2e} exceeds 1e-6",
                       FemmechWarning, stacklevel=2)
     if method == "dense" or n_modes is None:
         count, cut = None, None
-    return EigenResult(omega2, X, method, shift, res, count, cut)
+    solver = None if method == "dense" else (
+        solvers.resolve(None, n) if factor is None else getattr(factor, "name", "user"))
+    return EigenResult(omega2, X, method, shift, res, count, cut, solver=solver)
 
 
-def _cut_above(lam: float, K, M) -> float:
-    return lam + 1e-6 * max(abs(lam), 1e-6 * eigenvalue_scale(K, M))
+def _cut_above(lam: float, scale: float) -> float:
+    return lam + 1e-6 * max(abs(lam), 1e-6 * scale)
 
 
 def _select(omega2, X, n_modes, band):
@@ -288,30 +367,34 @@ def _select(omega2, X, n_modes, band):
     return omega2[:count], X[:, :count]
 
 
-def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True):
+def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None):
     """Lowest ``n_modes`` eigenpairs (plus the rest of a cut cluster), Sturm-checked.
 
     Returns ``omega2, X, sturm_count, cut``. Where the Sturm count shows that a repeated
     eigenvalue has more members than ARPACK found, deflated runs add the missing ones.
     """
     n = K.shape[0]
-    lu = factorize(K - sigma * M) if factor is None else factor
+    scale = eigenvalue_scale(K, M) if scale is None else scale
+    lu = factorize(K - sigma * M, definite=None if sigma < 0 else False) \
+        if factor is None else factor
     guard = max(4, n_modes // 5)
+    limit = min(n - 2, _n_mass(M) - 1)  # ARPACK's k < n - 1 and below the Krylov dimension
     while True:
-        k = min(n_modes + guard, n - 2)
+        k = min(n_modes + guard, limit)
         if k < n_modes:
-            raise ValueError(f"{n_modes} modes of a {n}-DOF system: use the dense path"
-                             " (raise dense_below) or ask for fewer modes")
+            raise ValueError(f"{n_modes} modes of a {n}-DOF system with {_n_mass(M)} DOFs with"
+                             " mass: use the dense path (raise dense_below) or ask for fewer"
+                             " modes")
         omega2, X = _arpack(K, M, k, sigma, lu)
         count = _complete_cluster(omega2, n_modes)
-        if count < k or k == n - 2:
+        if count < k or k == limit:
             break
         guard *= 2  # a cluster of repeated eigenvalues fills all computed modes
     omega2, X = omega2[:count], X[:, :count]
     if not check:
         return omega2, X, None, None
     for _ in range(MAX_DEFLATIONS):
-        cut = _cut_above(omega2[-1], K, M)
+        cut = _cut_above(omega2[-1], scale)
         below = inertia_below(K, M, cut)
         if below is None or below == omega2.size:
             return omega2, X, below, cut
@@ -342,7 +425,8 @@ def _sparse_band(K, M, band, sigma, factor=None):
         return np.empty(0), np.empty((n, 0)), shift
     if count + 2 >= n - 1:
         raise ValueError(f"the band holds {count} of {n} eigenvalues: use the dense path")
-    lu = factorize(K - shift * M, pivot_threshold=0.01) if factor is None else factor
+    lu = factorize(K - shift * M, pivot_threshold=0.01, definite=False) \
+        if factor is None else factor
     omega2, X = np.empty(0), np.empty((n, 0))
     for _ in range(MAX_DEFLATIONS):
         k = min(count - omega2.size + 2, n - 2 - omega2.size)

@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from femmech.materials import check_real
+
 
 @dataclass(frozen=True)
 class PointMass:
@@ -30,6 +32,7 @@ class PointMass:
 
     def matrix(self) -> np.ndarray:
         """6x6 mass matrix, kg and kg m²."""
+        check_real(self.mass, f"point mass at {self.node!r}: mass")
         if not (np.isfinite(self.mass) and self.mass >= 0):
             raise ValueError(f"point mass at {self.node!r}: mass must be >= 0, got {self.mass}")
         out = np.zeros((6, 6))
@@ -63,7 +66,7 @@ class Spring:
     def matrix(self) -> np.ndarray:
         """Global 6x6 stiffness ``k`` (the element matrix is [[k, -k], [-k, k]])."""
         label = f"spring {self.node_a!r}-{self.node_b!r}"
-        k = np.asarray(self.stiffness, dtype=float)
+        k = _real_matrix(self.stiffness, f"{label}: stiffness")
         if k.ndim == 0:
             k = np.diag([float(k)] * 3 + [0.0] * 3)
         elif k.shape == (6,):
@@ -78,8 +81,19 @@ class Spring:
         return k
 
 
+def _real_matrix(value, label: str) -> np.ndarray:
+    """Float array of real numbers; TypeError naming ``label`` otherwise."""
+    try:
+        a = np.asarray(value)
+    except ValueError:  # ragged nested sequences
+        raise ValueError(f"{label} must be a rectangular array of numbers") from None
+    if a.dtype.kind not in "iuf":
+        raise TypeError(f"{label} must be real numbers, got {value!r}")
+    return a.astype(float)
+
+
 def _sym_psd(value, n: int, label: str) -> np.ndarray:
-    a = np.asarray(value, dtype=float)
+    a = _real_matrix(value, label)
     if a.shape == (n,):
         a = np.diag(a)
     if a.shape != (n, n):

@@ -2,9 +2,17 @@
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
+
+
+def check_real(value, label: str) -> None:
+    """TypeError naming ``label`` unless ``value`` is a real number (not a bool, string or
+    array, which would fail inside numpy with a message naming nothing)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{label} must be a real number, got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -38,6 +46,10 @@ class Material:
     name: str = "material"
 
     def __post_init__(self):
+        for key in ("E", "rho", "nu", "G"):
+            value = getattr(self, key)
+            if value is not None or key in ("E", "rho"):
+                check_real(value, f"material {self.name!r}: {key}")
         if not (np.isfinite(self.E) and self.E > 0):
             raise ValueError(f"material {self.name!r}: E must be positive and finite, got {self.E}")
         if not (np.isfinite(self.rho) and self.rho >= 0):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,6 +33,9 @@ class Mesh:
     ValueError
         Non-finite coordinates, cells referencing missing nodes, or groups referencing
         missing cells, each naming the offending item.
+    TypeError
+        Coordinates that are not real numbers, connectivity or group indices that are not
+        integers, or containers of the wrong kind, naming the item.
     """
 
     points: np.ndarray
@@ -40,7 +44,11 @@ class Mesh:
     node_sets: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __post_init__(self):
-        points = np.asarray(self.points, dtype=float)
+        points = _real_array(self.points, "points")
+        for label, value in (("cells", self.cells), ("cell_sets", self.cell_sets),
+                             ("node_sets", self.node_sets)):
+            if not isinstance(value, Mapping):
+                raise TypeError(f"{label} must be a dict, got {type(value).__name__}")
         if points.ndim != 2 or points.shape[1] not in (2, 3):
             raise ValueError(f"points must have shape (n_nodes, 3), got {points.shape}")
         if points.shape[1] == 2:
@@ -54,8 +62,11 @@ class Mesh:
         sets = {}
         for name, by_type in self.cell_sets.items():
             sets[name] = {}
+            if not isinstance(by_type, Mapping):
+                raise TypeError(f"cell set {name!r} must be a dict {{cell type: indices}},"
+                                f" got {type(by_type).__name__}")
             for kind, idx in by_type.items():
-                idx = np.asarray(idx, dtype=np.int64).ravel()
+                idx = _indices(idx, f"cell set {name!r} ({kind} cells)")
                 n_cells = len(self.cells.get(kind, ()))
                 if idx.size and (idx.min() < 0 or idx.max() >= n_cells):
                     raise ValueError(f"cell set {name!r} references {kind} cell"
@@ -64,7 +75,7 @@ class Mesh:
         object.__setattr__(self, "cell_sets", sets)
         node_sets = {}
         for name, nodes in self.node_sets.items():
-            nodes = np.asarray(nodes, dtype=np.int64).ravel()
+            nodes = _indices(nodes, f"node set {name!r}")
             if nodes.size and (nodes.min() < 0 or nodes.max() >= len(points)):
                 raise ValueError(f"node set {name!r} references node {nodes.max()},"
                                  f" but the mesh has {len(points)} nodes")
@@ -109,10 +120,35 @@ class Mesh:
         raise ValueError(f"unknown group {name!r}; the mesh has {self.group_names()}")
 
 
+def _real_array(value, label: str) -> np.ndarray:
+    """Float array from real numbers; TypeError naming ``label`` otherwise (complex values,
+    strings, objects: a cast would drop or garble them)."""
+    try:
+        raw = np.asarray(value)
+    except ValueError as exc:  # ragged nested sequences
+        raise ValueError(f"{label} must be a rectangular array of numbers ({exc})") from None
+    if raw.dtype.kind not in "iuf":
+        raise TypeError(f"{label} must be real numbers, got dtype {raw.dtype}")
+    return raw.astype(float)
+
+
+def _indices(value, label: str) -> np.ndarray:
+    """1-D int64 indices; TypeError naming ``label`` for non-integers (a float or bool
+    index would be truncated or read as 0/1, silently selecting other items)."""
+    idx = np.asarray(value).ravel()
+    if idx.size and idx.dtype.kind not in "iu":
+        raise TypeError(f"{label}: indices must be integers, got dtype {idx.dtype}")
+    return idx.astype(np.int64)
+
+
 def _check_cells(kind: str, cells, n_nodes: int) -> np.ndarray:
-    cells = np.asarray(cells)
     if kind not in NODES_PER_CELL:
         raise ValueError(f"unsupported cell type {kind!r}")
+    try:
+        cells = np.asarray(cells)
+    except ValueError:  # ragged nested sequences
+        raise ValueError(f"{kind} cells must be a rectangular (n, {NODES_PER_CELL[kind]})"
+                         " array of node indices") from None
     if cells.size == 0:
         return np.empty((0, NODES_PER_CELL[kind]), dtype=np.int64)
     if not np.issubdtype(cells.dtype, np.integer):
@@ -127,6 +163,14 @@ def _check_cells(kind: str, cells, n_nodes: int) -> np.ndarray:
         node = cells[e][(cells[e] < 0) | (cells[e] >= n_nodes)][0]
         raise ValueError(f"{kind} cell {e} (nodes {cells[e].tolist()}) references node {node},"
                          f" but the mesh has {n_nodes} nodes")
+    if kind != "line":  # (a line with one node twice is named by the beam's length check)
+        ordered = np.sort(cells, axis=1)
+        twice = np.flatnonzero((ordered[:, 1:] == ordered[:, :-1]).any(axis=1))
+        if twice.size:  # a collapsed cell: positive Jacobians inside, yet degenerate
+            e = twice[0]
+            node = ordered[e, 1:][ordered[e, 1:] == ordered[e, :-1]][0]
+            raise ValueError(f"{kind} cell {e} (nodes {cells[e].tolist()}) uses node {node}"
+                             f" twice: a degenerate cell ({twice.size} such cells)")
     return cells
 
 

@@ -198,6 +198,10 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
     beams = {} if beams is None else beams
     shells = {} if shells is None else shells
     solids = {} if solids is None else solids
+    if not isinstance(mesh, Mesh):
+        raise TypeError(f"mesh must be a Mesh, got {type(mesh).__name__}")
+    if mesh.n_nodes == 0:
+        raise ValueError("the mesh has no nodes")
     _check_types(beams, masses, springs, supports, rigid_links, interpolating_links)
     check_part_types(shells, solids)
     beam_set, Ke, Me, edofs = _beam_blocks(mesh, beams, bool(shells), bool(solids))
@@ -279,6 +283,9 @@ def _check_types(beams, masses, springs, supports, rigid_links, interpolating_li
                                ("rigid_links", rigid_links, RigidLink),
                                ("interpolating_links", interpolating_links,
                                 InterpolatingLink)):
+        if isinstance(items, (kind, str, Mapping)) or not hasattr(items, "__iter__"):
+            raise TypeError(f"{label} must be a sequence of {kind.__name__},"
+                            f" got {type(items).__name__} (wrap a single item in a list)")
         for i, item in enumerate(items):
             if not isinstance(item, kind):
                 raise TypeError(f"{label}[{i}] must be a {kind.__name__},"

@@ -51,8 +51,8 @@ class ShellProperty:
             raise TypeError(f"ShellProperty material must be a Material,"
                             f" got {type(self.material).__name__}")
         t = self.thickness
-        if not (isinstance(t, (int, float, np.floating, np.integer)) and np.isfinite(t)
-                and t > 0):
+        if isinstance(t, bool) or not (isinstance(t, (int, float, np.floating, np.integer))
+                                       and np.isfinite(t) and t > 0):
             raise ValueError(f"ShellProperty thickness must be a positive number, got {t!r}")
         if not (np.isfinite(self.drilling) and self.drilling > 0):
             raise ValueError(f"ShellProperty drilling must be positive, got {self.drilling!r}")

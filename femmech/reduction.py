@@ -343,8 +343,8 @@ def _factorize_interior(Kii, dofs):
     """
     try:
         lu = factorize(Kii)
-        order = np.argsort(lu.perm_c)  # column j of the factors is column order[j] of K_ii
-        ratio = lu.U.diagonal() / np.abs(Kii.diagonal()[order])
+        pivots, order = lu.pivots()  # pivot j belongs to row/column order[j] of K_ii
+        ratio = pivots / np.abs(Kii.diagonal()[order])
         bad = np.flatnonzero(~(ratio > PIVOT_RTOL))
         where = f" (zero pivot at {dof_label(int(dofs[order[bad[0]]]))})" if bad.size else ""
     except ValueError:
@@ -376,17 +376,21 @@ def _residual_vectors(Kii, Mii, Mib, Psi, Phi, lu):
 
     ``R = K_ii⁻¹ (M_ii Ψ + M_ib)`` minus its M-projection on Φ; a Rayleigh-Ritz solve
     in span(R) makes the vectors mutually K- and M-orthogonal (they are K-orthogonal to
-    Φ because ``Φᵀ K_ii R = Λ Φᵀ M_ii R = 0``). Directions of relative M-norm below
-    1e-10 of the vectors' size before the projection (linearly dependent ones, or all of
-    them when Φ holds every interior mode) are dropped.
+    Φ because ``Φᵀ K_ii R = Λ Φᵀ M_ii R = 0``). Each column is first scaled to unit
+    M-norm; directions of M-norm² below 1e-10 after the projection (linearly dependent
+    ones, or all of them when Φ holds every interior mode) are dropped. The scaling makes
+    the test independent of units: the columns of translational and rotational interface
+    DOFs differ by a length unit, and a threshold relative to their sum kept 36 vectors
+    of a frame in m-kg-s but 26 of the same frame in mm-t-s.
     """
     R = lu.solve(Mii @ Psi + Mib.toarray())
-    size = np.einsum("ij,ij->", R, Mii @ R)  # M-norm² before removing the Φ part
+    norms = np.sqrt(np.einsum("ij,ij->j", R, Mii @ R))  # M-norms before removing Φ
+    R = R / np.where(norms > 0, norms, 1.0)
     for _ in range(2):  # twice is enough (Kahan-Parlett) for M-orthogonality to Φ
         R = R - Phi @ (Phi.T @ (Mii @ R))
     gram = R.T @ (Mii @ R)
     w, V = np.linalg.eigh(0.5 * (gram + gram.T))
-    keep = w > 1e-10 * max(size, 1e-300)
+    keep = w > 1e-10
     R = R @ (V[:, keep] / np.sqrt(w[keep]))
     stiff = R.T @ (Kii @ R)
     omega2, Z = np.linalg.eigh(0.5 * (stiff + stiff.T))

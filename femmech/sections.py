@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from femmech.materials import check_real
+
 
 @dataclass(frozen=True)
 class BeamSection:
@@ -52,6 +54,10 @@ class BeamSection:
     name: str = "section"
 
     def __post_init__(self):
+        for key in ("A", "Iy", "Iz", "J", "Asy", "Asz", "Ip"):
+            value = getattr(self, key)
+            if value is not None or key in ("A", "Iy", "Iz", "J"):
+                check_real(value, f"section {self.name!r}: {key}")
         for key in ("A", "Iy", "Iz", "J"):
             value = getattr(self, key)
             if not (np.isfinite(value) and value > 0):
@@ -96,11 +102,13 @@ class BeamSection:
 
 def _positive(name: str, **values: float) -> None:
     for key, value in values.items():
+        check_real(value, f"{name}: {key}")
         if not (np.isfinite(value) and value > 0):
             raise ValueError(f"{name}: {key} must be positive and finite, got {value}")
 
 
 def _poisson(name: str, nu: float) -> None:
+    check_real(nu, f"{name}: nu")
     if not -1.0 < nu < 0.5:
         raise ValueError(f"{name}: nu must lie in (-1, 0.5), got {nu}")
 
@@ -143,6 +151,7 @@ def tube(outer_diameter: float, inner_diameter: float, nu: float = 0.3, name: st
     """
     _positive(name, outer_diameter=outer_diameter)
     _poisson(name, nu)
+    check_real(inner_diameter, f"{name}: inner_diameter")
     if not 0.0 <= inner_diameter < outer_diameter:
         raise ValueError(
             f"{name}: inner_diameter must lie in [0, outer_diameter), got {inner_diameter}"

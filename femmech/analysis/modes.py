@@ -5,16 +5,20 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 
-from femmech.linalg import eigenvalue_scale, solve_symmetric
+from femmech import solvers
+from femmech.dofs import DOF_PER_NODE
+from femmech.linalg import default_shift, eigenvalue_scale, solve_symmetric
 from femmech.model import FEModel
 from femmech.reduction import Superelement, frequency_error_estimates
 
 RIGID_TOL = 1e-12
 """Eigenvalues with ``|ω²| <= RIGID_TOL * scale`` are rigid-body modes (scale: see
-:func:`femmech.linalg.eigenvalue_scale`, roughly the largest element eigenvalue).
-Computed rigid-body eigenvalues are ~1e-17 of the scale; elastic modes of 1e-12 of the
-scale are ~1e-6 of the highest frequencies."""
+:func:`model_eigenvalue_scale`, a typical element eigenvalue). Computed rigid-body
+eigenvalues are ~1e-17 of the scale (also on free shells at span/thickness 1e4, whose
+lowest elastic eigenvalue is 3e-10 of it); elastic modes of 1e-12 of the scale are ~1e-6
+of the typical element frequency."""
 
 
 @dataclass(frozen=True)
@@ -44,6 +48,10 @@ class ModeSet:
         For modes of a reduced model: a-posteriori estimate of the relative frequency
         error against the unreduced model (see
         :func:`femmech.reduction.frequency_error_estimates`).
+    solver : str or None
+        Sparse direct solver of the shift-invert factorisation (``"superlu"``,
+        ``"cholmod"``, ``"pardiso"``; :mod:`femmech.solvers`), ``"pyamg"`` for LOBPCG,
+        None for dense LAPACK.
     """
 
     freq_hz: np.ndarray
@@ -55,6 +63,7 @@ class ModeSet:
     residual: np.ndarray
     sturm_count: int | None
     error_estimate: np.ndarray | None = None
+    solver: str | None = None
 
     @property
     def n_modes(self) -> int:
@@ -67,7 +76,8 @@ class ModeSet:
 
 
 def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, float] | None = None,
-          sigma: float | None = None, check: bool = True) -> ModeSet:
+          sigma: float | None = None, check: bool = True, solver: str | None = None,
+          method: str = "shift-invert") -> ModeSet:
     """Natural modes of ``model`` by shift-invert Lanczos (ARPACK) or dense LAPACK.
 
     Solves ``Kf φ = ω² Mf φ`` for the constrained system ``Kf = Tᵀ K T``, ``Mf = Tᵀ M T``
@@ -88,6 +98,15 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
         Shift in rad²/s² (default: ``-1e-6 ×`` the eigenvalue scale, or the band centre).
     check : bool
         Confirm by a Sturm-sequence count that no mode below the last one was missed.
+    solver : str, optional
+        Sparse direct solver (``"auto"``, ``"superlu"``, ``"cholmod"``, ``"pardiso"``);
+        default :func:`femmech.solvers.default_solver`. Reported in
+        :attr:`ModeSet.solver`.
+    method : str
+        ``"shift-invert"`` (Lanczos on a factorisation, Sturm-checked; dense LAPACK for
+        small models) or ``"lobpcg"`` (AMG-preconditioned LOBPCG without a factorisation,
+        for models too large to factorise: :mod:`femmech.lobpcg`; n_modes only, no
+        Sturm check).
 
     Returns
     -------
@@ -111,8 +130,58 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
     if model.n_free == 0:
         raise ValueError("all DOFs are constrained: the model has no free DOF")
     Kf, Mf = model.K_free, model.M_free
-    result = solve_symmetric(Kf, Mf, n_modes=n_modes, band=band, sigma=sigma, check=check)
-    return _mode_set(result, model.expand(result.vectors), eigenvalue_scale(Kf, Mf))
+    scale = model_eigenvalue_scale(model)
+    if method == "lobpcg":
+        result = _lobpcg(model, n_modes, band, sigma)
+    elif method == "shift-invert":
+        with solvers.use(solver):
+            result = solve_symmetric(Kf, Mf, n_modes=n_modes, band=band, sigma=sigma,
+                                     check=check, scale=scale)
+    else:
+        raise ValueError(f"method must be 'shift-invert' or 'lobpcg', got {method!r}")
+    return _mode_set(result, model.expand(result.vectors), scale)
+
+
+def _lobpcg(model: FEModel, n_modes, band, sigma):
+    from femmech.lobpcg import lobpcg_symmetric, near_nullspace, node_blocksize
+
+    if band is not None or sigma is not None or n_modes is None:
+        raise ValueError("method='lobpcg' computes the n_modes lowest modes: give n_modes,"
+                         " no band_hz and no sigma")
+    return lobpcg_symmetric(model.K_free, model.M_free, n_modes, B=near_nullspace(model),
+                            blocksize=node_blocksize(model.free))
+
+
+def model_eigenvalue_scale(model: FEModel) -> float:
+    """Eigenvalue scale (rad²/s²) of the free system: shift, rigid threshold, residuals.
+
+    The smallest, over the DOF components ux ... rz, of the median ratio
+    ``diag K_free / diag M_free`` (:func:`femmech.linalg.eigenvalue_scale` per
+    component). One median over all DOFs is ruled by the rotations of thin shells, whose
+    inertia ρt³/12 is tiny: at span/thickness 1e4 their ratios are 1e5 times the
+    translational ones and 1e13 times the lowest bending eigenvalue, so that the
+    threshold ``RIGID_TOL * scale`` declared the lowest bending modes rigid (0 Hz) and the
+    shift ``-1e-6 scale`` lay so far below them that shift-invert Lanczos could not
+    separate them (Sturm check failed).
+
+    Where rigid links tie every element into one rigid body, ``K_free = Tᵀ K T`` holds
+    only cancellation round-off (~eps times the element stiffness): its diagonal would
+    set a meaningless scale, and with it a shift above the round-off eigenvalues (K - σM
+    indefinite) and residuals relative to nothing. If no diagonal entry with mass exceeds
+    ``1e-10`` of the element stiffness scale, the scale of the unconstrained K and M is
+    used (every mode is then rigid).
+    """
+    Kf, Mf = model.K_free, model.M_free
+    dk = np.asarray(Kf.diagonal(), dtype=float)
+    dm = np.asarray(Mf.diagonal(), dtype=float)
+    noise = 1e-10 * float(np.abs(model.K.diagonal()).max(initial=0.0))
+    if noise > 0 and not np.any((dk > noise) & (dm > 0)):
+        return eigenvalue_scale(model.K, model.M)
+    component = model.free % DOF_PER_NODE
+    ok = (dk > 0) & (dm > 0)
+    medians = [np.median(dk[ok & (component == c)] / dm[ok & (component == c)])
+               for c in range(DOF_PER_NODE) if np.any(ok & (component == c))]
+    return float(min(medians)) if medians else eigenvalue_scale(Kf, Mf)
 
 
 def superelement_modes(se: Superelement, n_modes: int | None = None,
@@ -136,16 +205,28 @@ def superelement_modes(se: Superelement, n_modes: int | None = None,
         ``shapes`` are the recovered full-model shapes (n_dof, n_modes).
     """
     Kr, Mr = se.K, se.M
+    # a reduced pencil mixes interface and modal coordinates whose diagonal ratios differ
+    # by decades; its rigid-body eigenvalues sit at round-off of the largest eigenvalue
+    # (measured up to 1.4e-14 λ_max), so the rigid threshold (RIGID_TOL λ_max) and the
+    # residual floor (1e-9 λ_max: the residuals of rigid modes are ~eps λ_max) scale with
+    # λ_max itself. The largest diagonal ratio, used before, is only a lower bound of
+    # λ_max: 3000 times below it for a free shell at span/thickness 1e4, where five of the
+    # six rigid-body modes were then reported as elastic.
+    lam_max = _largest_eigenvalue(Kr, Mr)
     result = solve_symmetric(Kr, Mr, n_modes=n_modes, band=_band(band_hz),
+                             sigma=default_shift(Kr, Mr), scale=1e-3 * lam_max,
                              dense_below=np.iinfo(np.int64).max)
     estimate = None
     if model is not None:
         estimate = frequency_error_estimates(model, se, result.omega2, result.vectors)
-    # a reduced pencil mixes interface and modal coordinates whose diagonal ratios differ
-    # by decades; its rigid-body eigenvalues sit at round-off of the largest one, so the
-    # rigid threshold scales with the largest ratio (an upper estimate of λ_max)
-    ratio = np.diag(Kr)[np.diag(Mr) > 0] / np.diag(Mr)[np.diag(Mr) > 0]
-    return _mode_set(result, se.recover(result.vectors), float(ratio.max()), estimate)
+    return _mode_set(result, se.recover(result.vectors), lam_max, estimate)
+
+
+def _largest_eigenvalue(K, M) -> float:
+    """Largest finite eigenvalue of a dense pencil (shift-inverted, eigenvalues only)."""
+    sigma = default_shift(K, M)
+    mu = scipy.linalg.eigh(M, K - sigma * M, eigvals_only=True)
+    return float(sigma + 1.0 / mu[mu > 1e-12 * mu.max()].min())
 
 
 def _band(band_hz):
@@ -162,7 +243,8 @@ def _mode_set(result, shapes, scale, estimate=None) -> ModeSet:
     rigid = np.abs(result.omega2) <= RIGID_TOL * scale
     freq = np.where(rigid, 0.0, np.sqrt(np.clip(result.omega2, 0.0, None)) / (2 * np.pi))
     return ModeSet(freq, result.omega2, shapes, rigid, result.method, result.sigma,
-                   result.residual, result.sturm_count, estimate)
+                   result.residual, result.sturm_count, estimate,
+                   getattr(result, "solver", None))
 
 
 def rigid_body_frequencies(model: FEModel) -> np.ndarray:

@@ -10,6 +10,9 @@ At each frozen drive angle φ the coupled system (seed 5.2.2 eq. 9) gives the ei
 Modes are followed from angle to angle by the modal assurance criterion (MAC, mass
 weighted) and frequency continuity, solved as an assignment problem, so crossing branches
 keep their identity (they swap order) and veering branches keep theirs (they do not).
+Clusters of (nearly) repeated frequencies, whose vectors are any basis of their subspace,
+are compared as subspaces. Growing motions (flutter: complex λ; divergence: λ < 0; Re s > 0)
+are kept and flagged (:attr:`Sweep.unstable`), never reported as plain frequencies.
 """
 
 from __future__ import annotations
@@ -27,6 +30,20 @@ from femmech.linalg import dense_symmetric
 SYMMETRY_RTOL = 1e-10
 """C(φ) counts as symmetric when ``max|C - Cᵀ| <= SYMMETRY_RTOL * max|C|``."""
 
+CLUSTER_RTOL = 1e-3
+"""Frequencies closer than this (relative, chained) form a cluster for tracking: a branch
+is compared with the span of a cluster (subspace MAC), not with its arbitrary basis."""
+
+REAL_RTOL = 1e-9
+"""λ (or s) with ``|Im| <= REAL_RTOL |λ|`` counts as real (LAPACK round-off)."""
+
+ZERO_RTOL = 1e-12
+"""λ with ``|λ| <= ZERO_RTOL`` times the largest diagonal ratio of C and M counts as zero
+(rigid-body modes; cf. :data:`femmech.analysis.modes.RIGID_TOL`)."""
+
+UNSTABLE_RTOL = 1e-9
+"""A branch is flagged unstable where its damping ratio is below ``-UNSTABLE_RTOL``."""
+
 
 @dataclass(frozen=True)
 class Sweep:
@@ -37,17 +54,20 @@ class Sweep:
     phi : ndarray (n_angles,)
         Drive angles, rad.
     freq_hz : ndarray (n_angles, n_modes)
-        Quasi-eigenfrequency of each tracked branch (column), Hz: ``sqrt(Re λ)/2π`` for
-        the undamped forms, the damped frequency ``Im s / 2π`` with damping.
+        Quasi-eigenfrequency of each tracked branch (column), Hz: ``Re √λ / 2π`` for
+        the undamped forms (0 for λ < 0), the damped frequency ``Im s / 2π`` with damping.
     eigenvalues : ndarray (n_angles, n_modes), complex
         λ = ω² (undamped forms) or s (damped form) of each branch.
     damping_ratio : ndarray (n_angles, n_modes)
-        ``-Re s / |s|`` (damped form); ``-Im λ / (2 Re λ)`` growth indicator for an
-        unsymmetric C (negative: a growing, flutter-type mode); 0 for symmetric C.
+        ``-Re s / |s|`` (damped form). Undamped forms (motion ``e^{st}``, ``s = ±i√λ``):
+        that of the growing root, 0 for real λ > 0, ``-|Im √λ| / |√λ|`` < 0 for complex λ
+        (flutter: both members of the conjugate pair grow) and -1 for λ < 0 (divergence).
+        Negative values flag growing motion (:attr:`unstable`).
     vectors : ndarray (n_angles, n, n_modes) or None
         Mode shapes (global coordinates), mass-normalised, if requested.
     mac_step : ndarray (n_angles, n_modes)
-        MAC of each branch with itself at the previous angle (1 at the first angle).
+        MAC of each branch with itself at the previous angle (1 at the first angle); in a
+        cluster of close frequencies, the MAC with the cluster's span (subspace MAC).
     form : str
         ``"symmetric"``, ``"unsymmetric"`` or ``"damped"`` (the most general used).
     """
@@ -60,6 +80,13 @@ class Sweep:
     mac_step: np.ndarray
     form: str
 
+    @property
+    def unstable(self) -> np.ndarray:
+        """(n_angles, n_modes) bool: the branch's frozen-angle motion grows (flutter,
+        divergence or Re s > 0). A quasi-static indicator; the stability of the
+        time-periodic system is decided by :mod:`femmech.analysis.stability`."""
+        return self.damping_ratio < -UNSTABLE_RTOL
+
 
 def frozen_modes(M, B, C, n_modes: int, damped: bool = False, H=None):
     """Lowest quasi-modes at one angle (dense): (eigenvalues, freq_hz, ratio, V, form).
@@ -69,35 +96,80 @@ def frozen_modes(M, B, C, n_modes: int, damped: bool = False, H=None):
     harmonic motion); μ are the interface forces of the mode.
     """
     M, B, C = (np.asarray(A) for A in (M, B, C))
+    scale = _lambda_scale(M, C)
+    symmetric = np.abs(C - C.T).max() <= SYMMETRY_RTOL * max(np.abs(C).max(), 1e-300)
     if H is not None and len(H):
-        return _constrained_modes(M, C, np.asarray(H), n_modes, damped)
-    scale = max(np.abs(C).max(), 1e-300)
-    symmetric = np.abs(C - C.T).max() <= SYMMETRY_RTOL * scale
+        return _constrained_modes(M, C, np.asarray(H), n_modes, damped, symmetric, scale)
     if damped:
-        n = M.shape[0]
-        A = np.block([[np.zeros((n, n)), np.eye(n)], [-C, -B]])
-        E = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), M]])
-        s, Z = sla.eig(A, E)
-        finite = np.isfinite(s) & (s.imag > 0)
-        s, V = s[finite], Z[:n, finite]
-        order = np.argsort(s.imag)[:n_modes]
-        s, V = s[order], V[:, order]
-        return s, s.imag / (2 * np.pi), -s.real / np.abs(s), _normalise(V, M), "damped"
+        return _damped_modes(M, B, C, n_modes, scale)
     if symmetric:
-        lam, V = dense_symmetric(0.5 * (C + C.T), M, n_modes)
-        freq = np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi)
-        return lam.astype(complex), freq, np.zeros(n_modes), V, "symmetric"
-    lam, V = sla.eig(C, M)
-    finite = np.isfinite(lam)
-    lam, V = lam[finite], V[:, finite]
-    order = np.argsort(lam.real)[:n_modes]
-    lam, V = lam[order], V[:, order]
-    freq = np.sqrt(np.clip(lam.real, 0.0, None)) / (2 * np.pi)
-    ratio = np.where(lam.real > 0, -lam.imag / (2 * np.abs(lam.real) + 1e-300), 0.0)
+        try:
+            lam, V = dense_symmetric(0.5 * (C + C.T), M, n_modes)
+        except ValueError:  # C - σM indefinite: eigenvalues below σ < 0 (divergence)
+            lam, V = _general_modes(0.5 * (C + C.T), M, n_modes)
+            lam, V = lam.real.astype(complex), _normalise(V.real, M)
+        freq, ratio = _undamped(lam, scale)
+        return lam.astype(complex), freq, ratio, V, "symmetric"
+    lam, V = _general_modes(C, M, n_modes)
+    freq, ratio = _undamped(lam, scale)
     return lam, freq, ratio, _normalise(V, M), "unsymmetric"
 
 
-def _constrained_modes(M, C, H, n_modes, damped):
+def _lambda_scale(M, C) -> float:
+    """Largest ``|C_ii| / M_ii`` over coordinates with mass: a (lower) estimate of max |λ|,
+    the scale of round-off in λ."""
+    dm, dc = np.diag(M), np.abs(np.diag(C))
+    ratio = dc[dm > 0] / dm[dm > 0]
+    return float(ratio.max()) if ratio.size and ratio.max() > 0 else 1.0
+
+
+def _general_modes(C, M, n_modes):
+    """Lowest (by Re λ) finite eigenpairs of ``C v = λ M v`` (QZ), conjugate pairs with
+    Im λ > 0 first."""
+    lam, V = sla.eig(C, M)
+    finite = np.isfinite(lam) & (np.abs(lam) < 1e300)
+    lam, V = lam[finite], V[:, finite]
+    order = np.lexsort((-lam.imag, lam.real))[:n_modes]
+    return lam[order], V[:, order]
+
+
+def _undamped(lam, scale):
+    """Frequency (Hz) and damping ratio of undamped quasi-modes from λ = ω² (complex).
+
+    The motion is ``e^{st}`` with ``s² = -λ``, ``s = ±i√λ``: real λ > 0 oscillates
+    (ratio 0); λ < 0 (divergence) and complex λ (flutter; both members of a conjugate
+    pair) have a root with ``Re s = |Im √λ| > 0`` (ratio ``-|Im √λ| / |√λ|``). λ within
+    ``ZERO_RTOL * scale`` of zero (rigid-body modes) and imaginary parts below
+    ``REAL_RTOL |λ|`` (round-off) count as zero.
+    """
+    lam = np.asarray(lam, dtype=complex)
+    lam = np.where(np.abs(lam.imag) <= REAL_RTOL * np.abs(lam), lam.real, lam)
+    lam = np.where(np.abs(lam) <= ZERO_RTOL * scale, 0.0, lam)
+    root = np.sqrt(lam)  # principal branch: Re >= 0
+    size = np.abs(root)
+    ratio = -np.abs(root.imag) / np.where(size > 0, size, 1.0)
+    return root.real / (2 * np.pi), ratio
+
+
+def _damped_modes(M, B, C, n_modes, scale):
+    """Damped quasi-modes from the first-order form (QZ): one root of each oscillating
+    pair (Im s > 0), plus growing real roots (divergence, Re s > 0), which would otherwise
+    be dropped with the decaying real roots of overdamped motions."""
+    n = M.shape[0]
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-C, -B]])
+    E = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), M]])
+    s, Z = sla.eig(A, E)
+    finite = np.isfinite(s) & (np.abs(s) < 1e300)
+    real = np.abs(s.imag) <= REAL_RTOL * np.abs(s)
+    growing = real & (s.real > 1e-6 * np.sqrt(scale))
+    keep = finite & (((s.imag > 0) & ~real) | growing)
+    s, V = np.where(real, s.real, s)[keep], Z[:n, keep]
+    order = np.argsort(s.imag, kind="stable")[:n_modes]
+    s, V = s[order], V[:, order]
+    return s, s.imag / (2 * np.pi), -s.real / np.abs(s), _normalise(V, M), "damped"
+
+
+def _constrained_modes(M, C, H, n_modes, damped, symmetric, scale):
     """Quasi-modes of the multiplier form (QZ on the augmented pencil, finite λ only)."""
     if damped:
         raise ValueError("the multiplier form supports undamped quasi-modes; use the primal"
@@ -106,14 +178,11 @@ def _constrained_modes(M, C, H, n_modes, damped):
     A = np.block([[C, H.T], [H, np.zeros((n_c, n_c))]])
     E = np.zeros_like(A)
     E[:n, :n] = M
-    lam, Z = sla.eig(A, E)
-    finite = np.isfinite(lam) & (np.abs(lam) < 1e300)
-    lam, V = lam[finite], Z[:n, finite]
-    order = np.argsort(lam.real)[:n_modes]
-    lam, V = lam[order], V[:, order]
+    lam, Z = _general_modes(A, E, n_modes)
+    V = Z[:n]
     V = _normalise(V.real if np.abs(V.imag).max() <= 1e-12 * np.abs(V).max() else V, M)
-    freq = np.sqrt(np.clip(lam.real, 0.0, None)) / (2 * np.pi)
-    return lam, freq, np.zeros(lam.size), V, "symmetric"
+    freq, ratio = _undamped(lam, scale)
+    return lam, freq, ratio, V, "symmetric" if symmetric else "unsymmetric"
 
 
 def _normalise(V, M):
@@ -237,6 +306,14 @@ def _sweep_loop(matrices, n, H, phi, n_modes, extra, damped, track, keep_vectors
     for a in range(n_angles):
         M, B, C = matrices(a)
         ev, f, r, V, form = frozen_modes(M, B, C, extra, damped, H)
+        limit = n - (0 if damped else 1)
+        while track and ev.size == extra < limit and _cuts_cluster(f, n_modes):
+            extra = min(2 * extra, limit)  # complete the cluster (kept for later angles)
+            ev, f, r, V, form = frozen_modes(M, B, C, extra, damped, H)
+        if ev.size < n_modes:
+            raise ValueError(f"at {phi[a]:.6g}: only {ev.size} finite quasi-modes (massless"
+                             " coordinates have infinite eigenvalues); ask for at most"
+                             f" {ev.size} modes")
         forms.add(form)
         if track and previous is not None:
             pick, macs = _assign(previous, V, f, M, frequency_weight)
@@ -254,14 +331,62 @@ def _sweep_loop(matrices, n, H, phi, n_modes, extra, damped, track, keep_vectors
 
 
 def _assign(previous, V, f, M, weight):
-    """Columns of V continuing each previous branch (Hungarian assignment)."""
+    """Columns of V continuing each previous branch (Hungarian assignment).
+
+    The similarity of a previous branch i and a candidate j is the larger of two
+    subspace MACs: of branch i with the span of j's cluster, and of j with the span of
+    i's cluster (clusters: :func:`clusters`); for isolated modes both are the MAC. A
+    branch thus stays in its cluster although the cluster's vectors are an arbitrary
+    basis, and a cluster that splits (or forms) is followed. Within a cluster the
+    vector MAC breaks ties (``0.1 × (subspace MAC - MAC)``), so that close but distinct
+    modes, e.g. at a crossing, keep their identity.
+    """
     V_prev, f_prev = previous
     mac = mac_matrix(V_prev, V, M)
+    sub = np.maximum(subspace_mac(V_prev, V, clusters(f), M),
+                     subspace_mac(V, V_prev, clusters(f_prev), M).T)
     jump = np.abs(f[None, :] - f_prev[:, None]) / np.maximum(f_prev[:, None], 1e-12)
-    rows, cols = linear_sum_assignment(1.0 - mac + weight * jump)
+    rows, cols = linear_sum_assignment(1.0 - sub + weight * jump + 0.1 * (sub - mac))
     order = np.argsort(rows)
     pick = cols[order]
-    return pick, mac[rows[order], pick]
+    return pick, sub[rows[order], pick]
+
+
+def _cuts_cluster(freq_hz, n_modes: int) -> bool:
+    """True if the last computed frequency is in the cluster of the n-th lowest: the
+    candidates then hold only part of a cluster, whose span tracking needs whole."""
+    groups = clusters(freq_hz)
+    order = np.argsort(freq_hz, kind="stable")
+    where = {int(i): k for k, g in enumerate(groups) for i in g}
+    return where[int(order[n_modes - 1])] == where[int(order[-1])]
+
+
+def clusters(freq_hz, rtol: float = CLUSTER_RTOL) -> list[np.ndarray]:
+    """Groups of indices of close frequencies: sorted neighbours closer than ``rtol``
+    times the frequency (frequencies below 1e-3 of the largest count as that size, so
+    rigid-body modes at round-off form one group)."""
+    freq = np.asarray(freq_hz, dtype=float)
+    order = np.argsort(freq, kind="stable")
+    f = freq[order]
+    size = np.maximum(f, 1e-3 * max(float(np.abs(f).max(initial=0.0)), 1e-300))
+    breaks = np.flatnonzero(np.diff(f) > rtol * size[1:])
+    return np.split(order, breaks + 1)
+
+
+def subspace_mac(X, Y, groups, W=None) -> np.ndarray:
+    """(p, q): for column j of Y, the MAC of each column of X with ``span(Y[:, g])``, g the
+    group holding j: ``x̄ᵀ W Y_g (Y_gᴴ W Y_g)⁺ Y_gᴴ W x / (xᴴ W x)`` (1 if x lies in it).
+    A group of one column gives the plain MAC."""
+    WX = X if W is None else W @ X
+    nx = np.real(np.einsum("ij,ij->j", X.conj(), WX))
+    out = np.empty((X.shape[1], Y.shape[1]))
+    for g in groups:
+        Yg = Y[:, g]
+        P = Yg.conj().T @ WX
+        G = Yg.conj().T @ (Yg if W is None else W @ Yg)
+        coef = np.linalg.pinv(G, rcond=1e-12, hermitian=True) @ P
+        out[:, g] = (np.real(np.einsum("ij,ij->j", P.conj(), coef)) / nx)[:, None]
+    return out
 
 
 def frequency_sensitivities(build, p: float, phi: float, n_modes: int, Omega: float = 0.0,

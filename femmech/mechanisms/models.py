@@ -89,9 +89,21 @@ class RheolinearModel:
                 (phi, Omega, Omega_dot)]
         inputs = [c for x in cols for c in x]
         compiled = self._compiled[which]
-        out = compiled(inputs, _param_values(compiled, self.parameters), self.position_functions)
+        with np.errstate(all="ignore"):  # reported below, naming the position
+            out = compiled(inputs, _param_values(compiled, self.parameters),
+                           self.position_functions)
         batch = phi.shape[:-1] if n_drives > 1 else phi.shape
-        return out.reshape(batch + shape)
+        out = out.reshape(batch + shape)
+        bad = ~np.isfinite(out.reshape(batch + (-1,))).all(axis=-1)
+        if bad.any():
+            where = phi[np.unravel_index(np.flatnonzero(bad)[0], batch)] if batch else phi
+            raise ValueError(
+                f"mechanism {self.mechanism.name!r}: {'MBCF'[which]} is not finite at drive"
+                f" position {np.round(where, 12).tolist()} ({int(bad.sum())} of"
+                f" {bad.size} positions): outside the range of motion, or a singular"
+                " position (stroke limit, dead centre) where a position derivative is"
+                " infinite")
+        return out
 
     def M(self, phi) -> np.ndarray:
         """Mass matrix M(φ) = (m̄_jk), shape S + (n, n), symmetric."""
@@ -232,7 +244,7 @@ class LagrangeModel:
         return Accelerations(qdd, drive)
 
 
-def _lagrange_compiled(terms: LagrangeTerms) -> dict:
+def _lagrange_compiled(terms: LagrangeTerms, constraints: tuple = ()) -> dict:
     inputs = terms.coordinates + terms.velocities
     N = len(terms.coordinates)
     chris = tuple(terms.christoffel[k, l, j] for k in range(N) for l in range(N)
@@ -244,7 +256,8 @@ def _lagrange_compiled(terms: LagrangeTerms) -> dict:
              "jacobian": (_flat(terms.constraint_jacobian),
                           (terms.constraint_jacobian.shape[0], N)),
              "curvature": (_flat(terms.constraint_curvature),
-                           (terms.constraint_curvature.shape[0],))}
+                           (terms.constraint_curvature.shape[0],)),
+             "constraints": (tuple(constraints), (len(constraints),))}
     return {k: (compile_expressions(e, inputs), s) for k, (e, s) in table.items()}
 
 
@@ -255,7 +268,7 @@ def second_kind(mechanism: Mechanism, parameters: Mapping | None = None,
     Parameters and position functions as for :func:`rheolinear`.
     """
     terms = lagrange_terms(mechanism)
-    compiled = _lagrange_compiled(terms)
+    compiled = _lagrange_compiled(terms, mechanism.constraints)
     values, funcs = check_bindings([c for c, _ in compiled.values()], parameters or {},
                                    position_functions or {}, _known_parameters(mechanism))
     return LagrangeModel(mechanism, terms, values, funcs, compiled)
@@ -295,6 +308,14 @@ class MixedModel:
     """
 
     lagrange: LagrangeModel
+
+    def constraints(self, q) -> np.ndarray:
+        """Constraint values f_i(q) (eq. 15), shape (..., n_c), for q of shape (..., N)."""
+        return self.lagrange._eval("constraints", q)
+
+    def jacobian(self, q) -> np.ndarray:
+        """Constraint Jacobian h_ij = ∂f_i/∂q_j (eq. 17), shape (..., n_c, N)."""
+        return self.lagrange._eval("jacobian", q)
 
     def solve(self, q, qd) -> MixedSolution:
         """Assemble and solve A x = b at one state ``q``, ``qd`` of shape (N + n_c,)."""

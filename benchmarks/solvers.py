@@ -1,0 +1,243 @@
+"""Benchmark: full 20-mode eigen solve with each installed sparse direct solver.
+
+For each model (grid space frames of ~20k and ~150k DOFs, optionally a hexahedral solid
+block of ~35k DOFs, where the factor is much denser) and each backend of
+:mod:`femmech.solvers` (SuperLU always; CHOLMOD and MKL PARDISO when installed):
+
+- *unit*: the cost model of a 20-mode shift-invert solve, measured on its own: symbolic
+  analysis + numeric factorisation of ``K - σM`` + 55 single-vector solves (one thread
+  during the solves, as in ARPACK's loop);
+- *eigen*: ``femmech.modes(model, 20, solver=...)``, split into the shift factorisation,
+  ARPACK (with the number of solves it made) and the Sturm check (an indefinite
+  factorisation of ``K - cut M``), with its peak memory;
+- *ratio*: eigen time / the unit time of the fastest backend on that model (issue 10
+  target: <= 1.3), and the same without the Sturm check;
+- *agreement*: the largest relative difference of the frequencies from the first
+  backend's (SuperLU).
+
+Thread settings (:func:`femmech.threads.describe`), library versions and the machine are
+printed with the tables.
+
+Usage::
+
+    python benchmarks/solvers.py [--sizes 20k,150k,solid] [--solvers superlu,pardiso]
+
+Results are printed and written to ``benchmarks/results/solvers.txt``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+import femmech as fm
+import femmech.linalg
+from femmech import sections, solvers, threads
+from femmech.generators import grid_frame
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from frame_modes import (  # noqa: E402  (sibling benchmark: shared measurement helpers)
+    PhaseTimer,
+    _return_freed_memory,
+    _table,
+    machine_info,
+    peak_memory,
+    write_report,
+)
+
+N_MODES = 20
+N_SOLVES = 55
+STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
+SECTION = sections.rectangular_hollow(0.08, 0.08, 0.005)
+BAY = 0.5  # m
+
+# name: (kind, size parameters)
+MODELS = {
+    "tiny": ("frame", ((2, 2, 2), 4)),        # 1 080 free DOFs (smoke test)
+    "20k": ("frame", ((5, 5, 5), 8)),         # 23 760 free DOFs
+    "150k": ("frame", ((9, 9, 9), 10)),       # 151 200 free DOFs
+    "solid": ("solid", (40, 16, 16)),         # 34 680 free DOFs, hexahedra
+}
+
+
+def build(name):
+    kind, params = MODELS[name]
+    if kind == "frame":
+        bays, subdivisions = params
+        mesh = grid_frame(bays, tuple(BAY * b for b in bays), subdivisions)
+        prop = fm.BeamProperty(SECTION, STEEL)
+        return fm.build_model(mesh, dict.fromkeys(mesh.cell_sets, prop),
+                              supports=[fm.Support("base")])
+    return solid_block(*params)
+
+
+def solid_block(nx, ny, nz):
+    """Steel block 1 x 0.4 x 0.4 m of nx x ny x nz hexahedra, clamped at x = 0."""
+    xs, ys, zs = np.linspace(0, 1, nx + 1), np.linspace(0, 0.4, ny + 1), \
+        np.linspace(0, 0.4, nz + 1)
+    grid = np.stack(np.meshgrid(xs, ys, zs, indexing="ij"), axis=-1).reshape(-1, 3)
+    index = np.arange(grid.shape[0]).reshape(nx + 1, ny + 1, nz + 1)
+    c = index[:-1, :-1, :-1].ravel()
+    sy, sz = nz + 1, 1
+    sx = (ny + 1) * (nz + 1)
+    hexa = np.column_stack([c, c + sx, c + sx + sy, c + sy,
+                            c + sz, c + sx + sz, c + sx + sy + sz, c + sy + sz])
+    mesh = fm.Mesh(grid, {"hexahedron": hexa}, {"solid": {"hexahedron": np.arange(len(hexa))}})
+    root = np.flatnonzero(grid[:, 0] < 1e-12)
+    return fm.build_model(mesh, solids={"solid": fm.SolidProperty(STEEL)},
+                          supports=[fm.Support(root, "translations")])
+
+
+def unit_cost(model, name, sigma):
+    """(analyse s, factorise s, seconds of N_SOLVES single-vector solves)."""
+    A = (model.K_free - sigma * model.M_free).tocsc()
+    factor = solvers.factorize(A, name, definite=True)
+    b = np.random.default_rng(7).standard_normal(A.shape[0])
+    with threads.solve_phase():
+        start = time.perf_counter()
+        for _ in range(N_SOLVES):
+            factor.solve(b)
+        seconds = time.perf_counter() - start
+    timings = dict(factor.timings)
+    del factor, A
+    gc.collect()
+    return timings["analyse"], timings["factorise"], seconds
+
+
+def _counting_factorize(counter, original):
+    def factorize(*args, **kwargs):
+        factor = original(*args, **kwargs)
+        solve = factor.solve
+
+        def counted(b):
+            counter[0] += 1
+            return solve(b)
+        factor.solve = counted
+        return factor
+    return factorize
+
+
+def eigen_solve(model, name, check=True):
+    """``fm.modes(model, 20, solver=name)`` with phases timed and solves counted."""
+    timer = PhaseTimer()
+    row = {}
+    counter = [0]
+    original = femmech.linalg.factorize
+    targets = [(femmech.linalg, "inertia_below", "sturm"),
+               (femmech.linalg, "_arpack", "arpack")]
+    femmech.linalg.factorize = _counting_factorize(counter, original)
+    try:
+        with timer.patched(targets + [(femmech.linalg, "factorize", "factor")]), \
+                peak_memory(row, "peak_mb"):
+            start = time.perf_counter()
+            result = fm.modes(model, n_modes=N_MODES, solver=name, check=check)
+            row["eigen_s"] = time.perf_counter() - start
+    finally:
+        femmech.linalg.factorize = original
+    row.update({f"{k}_s": timer.seconds.get(k, 0.0) for k in ("factor", "arpack", "sturm")})
+    row.update(solves=counter[0], omega2=result.omega2, n_modes=result.n_modes,
+               sturm_count=result.sturm_count, solver=result.solver, sigma=result.sigma,
+               max_residual=float(result.residual.max()))
+    return row
+
+
+def model_rows(case, names):
+    model = build(case)
+    n = model.n_free
+    sigma = femmech.linalg.default_shift(model.K_free, model.M_free)
+    rows = []
+    for name in names:
+        analyse, factorise, solve_s = unit_cost(model, name, sigma)
+        row = {"table": "solvers", "case": case, "free_dofs": n, "solver": name,
+               "analyse_s": analyse, "factorise_s": factorise, "solves_s": solve_s,
+               "unit_s": analyse + factorise + solve_s}
+        row.update(eigen_solve(model, name))
+        row["eigen_nocheck_s"] = eigen_solve(model, name, check=False)["eigen_s"]
+        rows.append(row)
+        gc.collect()
+    fastest = min(r["unit_s"] for r in rows)
+    ref = rows[0]["omega2"]
+    for r in rows:
+        r["fastest_unit_s"] = fastest
+        r["ratio"] = r["eigen_s"] / fastest
+        r["ratio_nocheck"] = r["eigen_nocheck_s"] / fastest
+        m = min(len(ref), len(r["omega2"]))
+        f, f_ref = np.sqrt(np.abs(r["omega2"][:m])), np.sqrt(np.abs(ref[:m]))
+        r["max_freq_diff"] = float(np.max(np.abs(f - f_ref) / f_ref))
+        r["f1_hz"] = float(f[0] / (2 * np.pi))
+    return rows
+
+
+def format_tables(rows) -> list[str]:
+    lines = [[r["case"], f"{r['free_dofs']:,}", r["solver"], f"{r['analyse_s']:.3f}",
+              f"{r['factorise_s']:.3f}", f"{r['solves_s']:.3f}", f"{r['unit_s']:.3f}",
+              f"{r['factor_s']:.2f}", f"{r['arpack_s']:.2f}", str(r["solves"]),
+              f"{r['sturm_s']:.2f}", f"{r['eigen_s']:.2f}", f"{r['peak_mb']:.0f}",
+              f"{r['ratio']:.2f}", f"{r['ratio_nocheck']:.2f}",
+              f"{r['sturm_count']}/{r['n_modes']}", f"{r['max_freq_diff']:.1e}"]
+             for r in rows]
+    return _table(f"Full {N_MODES}-mode eigen solve per sparse solver (unit = analyse +"
+                  f" factorise + {N_SOLVES} solves; ratio = eigen s / fastest unit s)",
+                  ["case", "free DOFs", "solver", "analyse s", "factor s",
+                   f"{N_SOLVES} solves s", "unit s", "eig:factor s", "eig:ARPACK s",
+                   "solves", "eig:Sturm s", "eigen s", "peak MB", "ratio",
+                   "ratio no Sturm", "Sturm", "max |df|/f"], lines)
+
+
+def header() -> list[str]:
+    versions = solvers.versions()
+    return machine_info() + [threads.describe(),
+                             "solvers: " + "; ".join(f"{k}: {v}" for k, v in versions.items()),
+                             f"auto picks: {solvers.resolve('auto', 10**6)} (SuperLU below"
+                             f" {solvers.AUTO_MIN_SIZE} unknowns)"]
+
+
+def main(sizes=("20k", "150k"), names=None,
+         out_file=Path(__file__).parent / "results" / "solvers.txt", echo=True):
+    """Run for ``sizes`` (keys of MODELS) and backends ``names`` (default: installed).
+
+    Returns one dict per (model, solver) with the timings (s), peak memory (MB), ratios
+    and frequency agreement shown in the table.
+    """
+    unknown = [s for s in sizes if s not in MODELS]
+    if unknown:
+        raise ValueError(f"unknown sizes {unknown}; choose from {list(MODELS)}")
+    names = list(solvers.available()[::-1] if names is None else names)
+    if "superlu" in names:  # the reference of the frequency agreement goes first
+        names.remove("superlu")
+        names.insert(0, "superlu")
+    for name in names:
+        solvers.resolve(name)
+    _return_freed_memory()
+    rows = []
+    for case in sizes:
+        rows += model_rows(case, names)
+        if echo:
+            print(f"... {case} done", file=sys.stderr, flush=True)
+    text = "\n".join(header() + [""] + format_tables(rows))
+    if echo:
+        print(text)
+    if out_file is not None:
+        write_report(out_file, text)
+    for r in rows:
+        r.pop("omega2")
+    return rows
+
+
+def _cli(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--sizes", default="20k,150k", help=f"subset of {','.join(MODELS)}")
+    parser.add_argument("--solvers", default=None,
+                        help=f"subset of {','.join(solvers.BACKENDS)} (default: installed)")
+    args = parser.parse_args(argv)
+    names = None if args.solvers is None else [s.strip() for s in args.solvers.split(",")]
+    main(tuple(s.strip() for s in args.sizes.split(",") if s.strip()), names)
+
+
+if __name__ == "__main__":
+    _cli()

@@ -1,0 +1,14 @@
+"""Hard-case tests (issue 9): one BLAS thread per module."""
+
+import pytest
+from threadpoolctl import threadpool_limits
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _single_blas_thread():
+    """Dense LAPACK on the small and mid-size matrices of these tests runs fastest on one
+    thread when the machine is shared (2 threads made the same solves several times
+    slower under load; cf. femmech.linalg.ARPACK_BLAS_THREADS). Module scope: the limit
+    ends with each module and does not leak into the tests that run after this folder."""
+    with threadpool_limits(limits=1, user_api="blas"):
+        yield

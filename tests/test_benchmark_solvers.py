@@ -1,0 +1,48 @@
+"""Smoke test of benchmarks/solvers.py at a tiny size (no timing assertions)."""
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+from femmech import solvers
+
+BENCHMARK = Path(__file__).resolve().parents[1] / "benchmarks" / "solvers.py"
+
+
+@pytest.fixture(scope="module")
+def bench():
+    spec = importlib.util.spec_from_file_location("bench_solvers", BENCHMARK)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_solver_benchmark_runs_every_installed_backend(bench, tmp_path):
+    out = tmp_path / "solvers.txt"
+    rows = bench.main(sizes=("tiny",), out_file=out, echo=False)
+    names = [r["solver"] for r in rows]
+    assert names[0] == "superlu"  # the reference of the agreement column
+    assert sorted(names) == sorted(solvers.available())
+    for r in rows:
+        # grid_frame((2, 2, 2), subdivisions=4), base joints clamped: 1 080 free DOFs
+        assert (r["case"], r["free_dofs"], r["solver"]) == ("tiny", 1080, r["solver"])
+        for key in ("analyse_s", "factorise_s", "solves_s", "unit_s", "factor_s",
+                    "arpack_s", "sturm_s", "eigen_s", "eigen_nocheck_s", "peak_mb"):
+            assert r[key] >= 0  # values not asserted: no timing in tests
+        assert r["ratio"] > 0
+        assert r["ratio_nocheck"] > 0
+        assert r["solves"] >= bench.N_MODES  # ARPACK applied the operator at least k times
+        # >= 20 modes, all confirmed by the Sturm count of this backend's inertia
+        assert r["n_modes"] >= bench.N_MODES
+        assert r["sturm_count"] == r["n_modes"]
+        assert r["max_residual"] < 1e-8
+        # every backend solves the same pencil: ARPACK converges to round-off (measured
+        # 1e-13), so 1e-10 leaves a margin without hiding a wrong mode
+        assert r["max_freq_diff"] < 1e-10
+    text = out.read_text()
+    for heading in ("Full 20-mode eigen solve", "femmech threads", "solvers: superlu",
+                    "auto picks"):
+        assert heading in text
+    with pytest.raises(ValueError, match="unknown sizes"):
+        bench.main(sizes=("huge",), out_file=None, echo=False)
