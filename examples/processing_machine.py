@@ -49,7 +49,16 @@ import numpy as np
 
 import femmech as fm
 from femmech import sections
+from femmech.analysis.forces import attachment_forces, drive_forces, support_reactions
 from femmech.analysis.reference import compare_coupled
+from femmech.analysis.response import (
+    ConstantSpeed,
+    frame_history,
+    periodic_steady_state,
+    rayleigh_coefficients,
+    rayleigh_damping,
+)
+from femmech.analysis.stability import speed_study
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
 from femmech.generators import grid_frame
@@ -60,9 +69,16 @@ from femmech.mechanisms import (
     processing_machine_parameters,
     quasi_modes,
     rheolinear,
+    second_kind,
 )
 from femmech.mechanisms.mounted import cam_follower
-from femmech.output.diagrams import write_sweep_csv
+from femmech.output.diagrams import (
+    plot_orbit,
+    plot_stability_chart,
+    plot_time_histories,
+    write_history_csv,
+    write_sweep_csv,
+)
 from femmech.reduction import craig_bampton
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")
@@ -74,6 +90,9 @@ BEARING_K = 2e8  # N/m
 DRIVE_TILT_K = 5e6  # N m/rad, tilting stiffness of the drive-end (gearbox) bearing
 DISC_MASS = (20.0, 2.0, 2.0)  # kg at the J0, J1, J2 stations
 PARAMS = processing_machine_parameters(kinematic_drive=True)
+# dynamics: the chapter's operating speed, frame (and FE shaft) Rayleigh damping
+OPERATING_RPM = 1200.0
+FRAME_ZETA, ZETA_BAND_HZ = 0.02, (80.0, 500.0)
 
 
 def segment_lengths(params=PARAMS) -> np.ndarray:
@@ -124,11 +143,11 @@ def build_fe(rigid_frame: bool = False, rho_scale: float = 1.0, per_segment: int
     points = np.vstack([frame.points, shaft_pts])
     lines = np.vstack([frame.cells["line"], frame.n_nodes + shaft_lines])
     n_frame_cells = len(frame.cells["line"])
+    stations = frame.n_nodes + stations
     mesh = fm.Mesh(points, {"line": lines},
                    {"frame": {"line": np.arange(n_frame_cells)},
                     "shaft": {"line": n_frame_cells + np.arange(n_s - 1)}},
-                   {"feet": frame.node_sets["base"]})
-    stations = frame.n_nodes + stations
+                   {"feet": frame.node_sets["base"], "drive_end": [int(stations[0])]})
     housings = [_nearest(frame.points, points[s]) for s in stations]
     brackets = np.array([_nearest(frame.points, points[s] + [0.0, BRACKET_OFFSET, 0.0])
                          for s in stations[1:]])
@@ -142,18 +161,22 @@ def build_fe(rigid_frame: bool = False, rho_scale: float = 1.0, per_segment: int
     return model, stations, brackets
 
 
-def mounts(stations, brackets) -> list[Mount]:
-    """The two cam mechanisms with the chapter's parameter names (U1: m1, c3, c6, ...)."""
+def cam_models(form=rheolinear) -> list:
+    """The two cam mechanisms with the chapter's parameter names (U1: m1, c3, c6, ...),
+    built by ``form`` (:func:`rheolinear` for the coupled system, :func:`second_kind`
+    for the drive torque)."""
     names = (("U1", "m1", "c3", "c6", "b3", "F1"), ("U2", "m2", "c4", "c7", "b4", "F2"))
-    out = []
-    for k, (U, m, c, cr, b, F) in enumerate(names):
-        mech = cam_follower(U, m, c, cr, b, F, name=f"cam {U}")
-        model = rheolinear(mech, {p: PARAMS[p] for p in (m, c, cr, b, F)},
-                           {U: processing_machine_cams()[U]})
-        out.append(Mount(model, (Attachment("q_s", int(stations[k + 1]), "rx"),
-                                 Attachment("y_c", int(stations[k + 1]), "uz"),
-                                 Attachment("y_f", int(brackets[k]), "uz")), name=f"cam{k + 1}"))
-    return out
+    return [form(cam_follower(U, m, c, cr, b, F, name=f"cam {U}"),
+                 {p: PARAMS[p] for p in (m, c, cr, b, F)}, {U: processing_machine_cams()[U]})
+            for U, m, c, cr, b, F in names]
+
+
+def mounts(stations, brackets) -> list[Mount]:
+    """The cam mechanisms attached to the shaft stations and the return-spring brackets."""
+    return [Mount(model, (Attachment("q_s", int(stations[k + 1]), "rx"),
+                          Attachment("y_c", int(stations[k + 1]), "uz"),
+                          Attachment("y_f", int(brackets[k]), "uz")), name=f"cam{k + 1}")
+            for k, model in enumerate(cam_models())]
 
 
 def build(f_max_hz: float = 1500.0, rigid_frame: bool = False, rho_scale: float = 1.0):
@@ -188,7 +211,73 @@ def rigid_check(phi, rho_scale: float = 1e-6):
     return float(np.abs(coupled.freq_hz / alone.freq_hz - 1).max()), coupled, alone
 
 
-def main(out_dir="out/processing_machine", n_angles: int = 181, n_modes: int = 9) -> dict:
+def dynamics(out_dir="out/processing_machine", rpm: float = OPERATING_RPM,
+             n_speeds: int = 70, zetas=(0.0025, 0.005, 0.01, 0.02),
+             n_steps: int = 128) -> dict:
+    """Periodic steady state at ``rpm`` and Floquet stability over speed.
+
+    Steady state (shooting, ρ∞ = 1, Richardson-extrapolated): follower deformations q of
+    both cams, shaft twist at
+    the cams, forces of the cams on shaft and frame, the motor torque at the kinematic
+    drive (reaction of the drive end's rx support, :func:`support_reactions`) next to the
+    sum of the cams' drive rows (what a rigid shaft would transmit), and the orbit of the
+    shaft centre at cam 1. Stability over 300..2400 rpm
+    (:func:`femmech.analysis.stability.speed_study`), with 2 f_k / j marked.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    base, _, model, _ = build()
+    rayleigh = rayleigh_coefficients(FRAME_ZETA, *ZETA_BAND_HZ)
+    system = rayleigh_damping(base, *rayleigh)
+    W = 2 * np.pi * rpm / 60.0
+    drive = ConstantSpeed(W)
+    r = periodic_steady_state(system, W, n_steps=720, rho_inf=1.0, richardson=True)
+    forces = attachment_forces(system, r, drive)
+    cams = [int(m.attachments[0].node) for m in system.mounts]
+    motor = support_reactions(system, model, r, [("drive_end", "rx")], *rayleigh)[:, 0]
+    rows = sum(drive_forces(lg, r, drive, system, mount=k)[:, 0]
+               for k, lg in enumerate(cam_models(second_kind)))
+    twist = frame_history(system, model, r.q, [(c, "rx") for c in cams])
+    centre = frame_history(system, model, r.q, [(cams[0], "uy"), (cams[0], "uz")])
+    deg = np.rad2deg(r.phi)
+    q = {f"cam{k + 1}.q": r.q[:, system.labels.index(f"cam{k + 1}.q")] for k in range(2)}
+    force_curves = dict(zip(forces.labels, forces.forces.T, strict=True))
+    plot_time_histories(deg, {
+        "follower deformation q (µm)": {k: 1e6 * v for k, v in q.items()},
+        "shaft twist at cam (mrad)": {f"cam{k + 1}": 1e3 * twist[:, k] for k in range(2)},
+        "cam force on frame (N)": {k: f for k, f in force_curves.items() if "y_" in k},
+        "torque (N m)": {"motor (drive-end reaction)": motor,
+                         "Σ cam drive rows (rigid shaft)": rows}},
+        out / "steady_state.png", xlabel="drive angle φ (deg)",
+        title=f"Processing machine at {rpm:.0f} rpm: periodic steady state")
+    plot_orbit(1e6 * centre[:, 0], 1e6 * centre[:, 1], out / "shaft_orbit_cam1.png",
+               "shaft centre at cam 1, u_y (µm)", "u_z (µm)",
+               f"Shaft at cam 1 over one revolution at {rpm:.0f} rpm")
+    write_history_csv(r.t, {"phi_deg": deg, **{f"{k}_m": v for k, v in q.items()},
+                            **{f"{k}_N_or_Nm": f for k, f in force_curves.items()},
+                            "motor_torque_Nm": motor, "cam_drive_rows_Nm": rows},
+                      out / "steady_state.csv")
+    study = speed_study(base, 2 * np.pi / 60.0 * np.linspace(300.0, 2400.0, n_speeds),
+                        FRAME_ZETA, ZETA_BAND_HZ, zetas, n_steps=n_steps)
+    plot_stability_chart(study.line, out / "stability_speed.png", quantity="growth_rate",
+                         title=f"Processing machine: growth rate, frame ζ = {FRAME_ZETA}",
+                         marks=study.marks, speed_unit="rpm")
+    plot_stability_chart(study.chart, out / "stability_chart.png", quantity="growth_rate",
+                         title="Processing machine: growth rate over speed and damping",
+                         marks=study.marks, speed_unit="rpm")
+    print(f"steady state at {rpm:.0f} rpm: follower deformation up to"
+          f" {1e6 * max(np.abs(v).max() for v in q.values()):.1f} µm, motor torque"
+          f" {motor.min():.1f} .. {motor.max():.1f} N m (cam drive rows"
+          f" {rows.min():.1f} .. {rows.max():.1f} N m)")
+    print(f"stability: growth rate {study.line.growth_rate.max():.2f} 1/s at most (nominal"
+          f" damping); {int((~study.chart.stable).sum())} of {study.chart.stable.size}"
+          " (speed, ζ) points unstable")
+    return {"steady_state": r, "forces": forces, "motor_torque": motor, "drive_rows": rows,
+            "study": study, "system": system}
+
+
+def main(out_dir="out/processing_machine", n_angles: int = 181, n_modes: int = 9,
+         with_dynamics: bool = True, n_speeds: int = 70) -> dict:
     """Sweep, plot, CSV and both checks; returns the key numbers."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -212,13 +301,17 @@ def main(out_dir="out/processing_machine", n_angles: int = 181, n_modes: int = 9
     print(f"reduced vs full at {len(check)} angles: max frequency error {errors.max():.2e},"
           f" min MAC {macs.min():.10f}")
     print(f"rigid frame vs chapter model: max relative difference {rigid_error:.2e}")
-    return {"sweep": result, "max_error": float(errors.max()), "min_mac": float(macs.min()),
-            "rigid_error": rigid_error, "n_full": full.n, "n_reduced": reduced.n}
+    summary = {"sweep": result, "max_error": float(errors.max()), "min_mac": float(macs.min()),
+               "rigid_error": rigid_error, "n_full": full.n, "n_reduced": reduced.n}
+    if with_dynamics:
+        summary["dynamics"] = dynamics(out, n_speeds=n_speeds)
+    return summary
 
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="out/processing_machine")
     parser.add_argument("--angles", type=int, default=181)
+    parser.add_argument("--speeds", type=int, default=70, help="speeds of the stability chart")
     args = parser.parse_args()
-    main(args.out, args.angles)
+    main(args.out, args.angles, n_speeds=args.speeds)

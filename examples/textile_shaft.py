@@ -32,12 +32,22 @@ import sympy
 
 import femmech as fm
 from femmech import sections
+from femmech.analysis.forces import attachment_forces, drive_forces, support_reactions
 from femmech.analysis.reference import compare_coupled
+from femmech.analysis.response import (
+    ConstantSpeed,
+    frame_history,
+    periodic_steady_state,
+    rayleigh_coefficients,
+    rayleigh_damping,
+)
+from femmech.analysis.stability import speed_study
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
 from femmech.mechanisms import (
     CamProfile,
     CamSegment,
+    Damper,
     Mechanism,
     PointMass,
     RotaryInertia,
@@ -46,8 +56,17 @@ from femmech.mechanisms import (
     polynomial_345,
     position_function,
     rheolinear,
+    second_kind,
 )
-from femmech.output.diagrams import plot_mac, write_sweep_csv, write_sweep_json
+from femmech.output.diagrams import (
+    plot_mac,
+    plot_orbit,
+    plot_stability_chart,
+    plot_time_histories,
+    write_history_csv,
+    write_sweep_csv,
+    write_sweep_json,
+)
 from femmech.output.machine import plot_coupled_mode
 from femmech.reduction import craig_bampton
 
@@ -56,20 +75,24 @@ SPACING = 0.1  # m between cams
 HEIGHT = 0.4  # m, shaft axis above the base beam
 BEARING_EVERY = 5  # cams between bearings
 BEARING_K = 2e8  # N/m, radial
-PARAMS = {"J_c": 2e-3, "m2": 2.0, "c2": 1e6}  # kg m², kg, N/m
+OPERATING_RPM = 900.0  # dynamics: main-shaft speed of the steady state
+FRAME_ZETA, ZETA_BAND_HZ = 0.02, (100.0, 600.0)  # frame and shaft Rayleigh damping
+# kg m², kg, N/m, N s/m (b2: 2 % of critical, 2ζ√(c2 m2) = 57 N s/m)
+PARAMS = {"J_c": 2e-3, "m2": 2.0, "c2": 1e6, "b2": 57.0}
 CAM = CamProfile((CamSegment(np.pi / 2, 0.03, polynomial_345()), CamSegment(np.pi / 2, 0.0),
                   CamSegment(np.pi / 2, -0.03, polynomial_345()), CamSegment(np.pi / 2, 0.0)))
 
 
 def cam_mechanism() -> Mechanism:
-    """One cam mechanism with shaft twist q_s, guide motion y_g and follower deflection q2."""
+    """One cam mechanism with shaft twist q_s, guide motion y_g and follower deflection q2
+    (damper b2 on q2)."""
     theta, qs, yg, q2 = sympy.symbols("theta q_s y_g q2")
-    Jc, m2, c2 = sympy.symbols("J_c m2 c2")
+    Jc, m2, c2, b2 = sympy.symbols("J_c m2 c2 b2")
     U = position_function("U")
     x2 = yg + U(theta + qs) + q2
     return Mechanism((qs, yg, q2, theta),
-                     (RotaryInertia(Jc, theta + qs), PointMass(m2, (x2,)), Spring(c2, q2)),
-                     drives=(theta,), name="cam")
+                     (RotaryInertia(Jc, theta + qs), PointMass(m2, (x2,)), Spring(c2, q2),
+                      Damper(b2, q2)), drives=(theta,), name="cam")
 
 
 def frame_and_shaft(n_cams: int, per_spacing: int = 2) -> tuple[fm.FEModel, np.ndarray,
@@ -135,8 +158,74 @@ def build(n_cams: int = 10, f_max_hz: float = 400.0, per_spacing: int = 2):
     return reduced, full, model, se
 
 
+def dynamics(out_dir="out/textile", n_cams: int = 10, rpm: float = OPERATING_RPM,
+             n_speeds: int = 60, zetas=(0.0025, 0.005, 0.01, 0.02),
+             n_steps: int = 128) -> dict:
+    """Periodic steady state at ``rpm`` and Floquet stability over speed.
+
+    Steady state (shooting, ρ∞ = 1, Richardson-extrapolated): follower deflections of the
+    first, middle and last
+    cam, the motor torque at the kinematic drive end (rx reaction,
+    :func:`~femmech.analysis.forces.support_reactions`) next to the sum of the cams'
+    drive rows (what a rigid shaft would transmit), the guide forces on the base beam,
+    and the orbit of the shaft at the middle cam. Stability over 300..1800 rpm
+    (:func:`femmech.analysis.stability.speed_study`), with 2 f_k / j marked.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    base, _, model, _ = build(n_cams)
+    rayleigh = rayleigh_coefficients(FRAME_ZETA, *ZETA_BAND_HZ)
+    system = rayleigh_damping(base, *rayleigh)
+    W = 2 * np.pi * rpm / 60.0
+    drive = ConstantSpeed(W)
+    r = periodic_steady_state(system, W, n_steps=720, rho_inf=1.0, richardson=True)
+    forces = attachment_forces(system, r, drive)
+    motor = support_reactions(system, model, r, [("drive", "rx")], *rayleigh)[:, 0]
+    lagrange = second_kind(cam_mechanism(), PARAMS, {"U": CAM})
+    rows = sum(drive_forces(lagrange, r, drive, system, mount=k)[:, 0] for k in range(n_cams))
+    shown = sorted({0, n_cams // 2, n_cams - 1})
+    middle = int(system.mounts[n_cams // 2].attachments[0].node)
+    orbit = frame_history(system, model, r.q, [(middle, "uy"), (middle, "uz")])
+    deg = np.rad2deg(r.phi)
+    q2 = {f"cam{k + 1}": r.q[:, system.labels.index(f"cam{k + 1}.q2")] for k in shown}
+    guide = {f"cam{k + 1}": forces.forces[:, forces.labels.index(f"cam{k + 1}.y_g")]
+             for k in shown}
+    plot_time_histories(deg, {
+        "follower deflection q2 (µm)": {k: 1e6 * v for k, v in q2.items()},
+        "guide force on base (kN)": {k: 1e-3 * v for k, v in guide.items()},
+        "torque (N m)": {"motor (drive-end reaction)": motor,
+                         "Σ cam drive rows (rigid shaft)": rows}},
+        out / "steady_state.png", xlabel="main-shaft angle φ (deg)",
+        title=f"{n_cams} cams at {rpm:.0f} rpm: periodic steady state")
+    plot_orbit(1e6 * orbit[:, 0], 1e6 * orbit[:, 1], out / "shaft_orbit.png",
+               f"shaft at cam {n_cams // 2 + 1}, u_y (µm)", "u_z (µm)",
+               f"Main shaft over one revolution at {rpm:.0f} rpm")
+    write_history_csv(r.t, {"phi_deg": deg, **{f"{k}.q2_m": v for k, v in q2.items()},
+                            **{f"{k}.guide_N": v for k, v in guide.items()},
+                            "motor_torque_Nm": motor, "cam_drive_rows_Nm": rows},
+                      out / "steady_state.csv")
+    study = speed_study(base, 2 * np.pi / 60.0 * np.linspace(300.0, 1800.0, n_speeds),
+                        FRAME_ZETA, ZETA_BAND_HZ, zetas, n_steps=n_steps,
+                        orders=range(1, 13))
+    plot_stability_chart(study.line, out / "stability_speed.png", quantity="growth_rate",
+                         title=f"{n_cams} cams: growth rate, frame ζ = {FRAME_ZETA}",
+                         marks=study.marks, speed_unit="rpm")
+    plot_stability_chart(study.chart, out / "stability_chart.png", quantity="growth_rate",
+                         title=f"{n_cams} cams: growth rate over speed and frame damping",
+                         marks=study.marks, speed_unit="rpm")
+    print(f"steady state at {rpm:.0f} rpm: follower deflection up to"
+          f" {1e6 * max(np.abs(v).max() for v in q2.values()):.1f} µm, motor torque"
+          f" {motor.min():.1f} .. {motor.max():.1f} N m (cam drive rows"
+          f" {rows.min():.1f} .. {rows.max():.1f} N m)")
+    print(f"stability: growth rate {study.line.growth_rate.max():.3f} 1/s at most (nominal"
+          f" damping); {int((~study.chart.stable).sum())} of {study.chart.stable.size}"
+          " (speed, ζ) points unstable")
+    return {"steady_state": r, "forces": forces, "motor_torque": motor, "drive_rows": rows,
+            "study": study, "system": system}
+
+
 def main(out_dir="out/textile", n_cams: int = 10, n_angles: int = 181,
-         n_modes: int = 6) -> dict:
+         n_modes: int = 6, with_dynamics: bool = True, n_speeds: int = 60) -> dict:
     """Sweep the coupled machine over one revolution; compare with the full model."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -165,10 +254,13 @@ def main(out_dir="out/textile", n_cams: int = 10, n_angles: int = 181,
           " per angle")
     print(f"reduced vs full at {len(check)} angles: max frequency error {errors.max():.2e},"
           f" min MAC {macs.min():.6f}")
-    return {"sweep": result, "max_error": errors.max(), "min_mac": macs.min(),
-            "time_per_angle_reduced": t_sweep / n_angles,
-            "time_per_angle_full": comparison.seconds_full.mean(),
-            "n_full": full.n, "n_reduced": reduced.n}
+    summary = {"sweep": result, "max_error": errors.max(), "min_mac": macs.min(),
+               "time_per_angle_reduced": t_sweep / n_angles,
+               "time_per_angle_full": comparison.seconds_full.mean(),
+               "n_full": full.n, "n_reduced": reduced.n}
+    if with_dynamics:
+        summary["dynamics"] = dynamics(out, n_cams, n_speeds=n_speeds)
+    return summary
 
 
 if __name__ == "__main__":
@@ -176,5 +268,6 @@ if __name__ == "__main__":
     parser.add_argument("--out", default="out/textile")
     parser.add_argument("--n", type=int, default=10, help="number of cam mechanisms")
     parser.add_argument("--angles", type=int, default=181)
+    parser.add_argument("--speeds", type=int, default=60, help="speeds of the stability chart")
     args = parser.parse_args()
-    main(args.out, args.n, args.angles)
+    main(args.out, args.n, args.angles, n_speeds=args.speeds)

@@ -98,7 +98,7 @@ def machine():
 @pytest.fixture(scope="module")
 def machine_run(machine, tmp_path_factory):
     out = tmp_path_factory.mktemp("processing_machine")
-    return out, machine.main(out, n_angles=37)
+    return out, machine.main(out, n_angles=37, with_dynamics=False)
 
 
 def test_processing_machine_shaft_gives_chapter_stiffness(machine):
@@ -165,7 +165,7 @@ def press():
 @pytest.fixture(scope="module")
 def press_run(press, tmp_path_factory):
     out = tmp_path_factory.mktemp("press")
-    return out, press.main(out, n_angles=37)
+    return out, press.main(out, n_angles=37, with_dynamics=False)
 
 
 def test_press_reduced_matches_full(press_run):

@@ -24,8 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from femmech.analysis.response import _drive
+from femmech.analysis.response import _drive, _node_component, frame_history
 from femmech.coupling import CoupledSystem, frame_row
+from femmech.dofs import COMPONENTS, DOF_PER_NODE
 
 
 @dataclass(frozen=True)
@@ -182,3 +183,50 @@ def drive_forces(lagrange, response, drive, system: CoupledSystem | None = None,
     residual = (np.einsum("tij,tj->ti", M, qdd) + lagrange.velocity_terms(q, qd)
                 + lagrange.gradient(q) - lagrange.Q(q, qd))
     return residual[:, [d]]
+
+
+def support_reactions(system: CoupledSystem, model, response, dofs, mass_coef: float = 0.0,
+                      stiffness_coef: float = 0.0) -> np.ndarray:
+    """Reactions at supported DOFs of the frame (e.g. a kinematically driven shaft end).
+
+    The support holds the DOF at zero, so its reaction is the DOF's row of the unconstrained
+    equations of motion, ``R_d = (K u + B u̇ + M ü)_d`` with ``B = a M + b K`` (Rayleigh,
+    as in :func:`~femmech.analysis.response.rayleigh_damping`); only the full-model DOFs
+    coupled to d are recovered (:func:`~femmech.analysis.response.frame_history`). For the
+    rotation about the shaft axis at a kinematic drive this is the drive torque the motor
+    supplies to keep φ(t), the shaft's own vibration included. Loads applied at d itself
+    (none in a coupled system: mechanisms act through attachments) are not subtracted.
+
+    Parameters
+    ----------
+    system : CoupledSystem
+    model : FEModel
+        The frame's FE model (its unconstrained K and M).
+    response : Response
+    dofs : sequence
+        Supported full-model DOFs: indices ``6 * node + component`` or ``(node, component)``.
+    mass_coef, stiffness_coef : float
+        Rayleigh coefficients a (1/s) and b (s) of the frame damping of the response.
+
+    Returns
+    -------
+    ndarray (n_t, n_dofs)
+        Force (N) or moment (N m) the support exerts on the frame.
+    """
+    d = []
+    for dof in dofs:
+        node, component = _node_component(model, dof)
+        d.append(DOF_PER_NODE * int(node) + COMPONENTS.index(component))
+    d = np.array(d, dtype=np.int64)
+    free = np.zeros(model.n_dof, dtype=bool)
+    free[model.free] = True
+    if free[d].any():
+        raise ValueError(f"DOF {int(d[free[d]][0])} (node {int(d[free[d]][0]) // DOF_PER_NODE})"
+                         " is not supported: a reaction exists only at supported DOFs")
+    K, M = model.K.tocsr()[d], model.M.tocsr()[d]
+    cols = np.union1d(K.indices, M.indices)  # CSR: column indices of the rows d
+    K, M = K[:, cols].toarray(), M[:, cols].toarray()
+    u, v, a = (frame_history(system, model, x, cols)
+               for x in (response.q, response.v, response.a))
+    B = mass_coef * M + stiffness_coef * K
+    return u @ K.T + v @ B.T + a @ M.T

@@ -235,7 +235,8 @@ def _initial(x, n, name):
 
 
 def periodic_steady_state(system, Omega: float, n_steps: int = 512, rho_inf: float = 0.8,
-                          angle_period: float = 2 * np.pi, phi0: float = 0.0) -> Response:
+                          angle_period: float = 2 * np.pi, phi0: float = 0.0,
+                          richardson: bool = False) -> Response:
     """Periodic forced response at constant drive speed, by shooting.
 
     With φ = φ₀ + Ω t the coefficients and the force repeat with T = Θ/Ω. The
@@ -259,6 +260,16 @@ def periodic_steady_state(system, Omega: float, n_steps: int = 512, rho_inf: flo
         Θ, rad: the machine cycle (2π when all mount ratios are integers).
     phi0 : float
         Drive angle at t = 0, rad.
+    richardson : bool
+        Also solve with 2 n_steps and return (4 x_{h/2} − x_h)/3 on the n_steps grid
+        (Richardson extrapolation of q, q', q''). With ρ∞ = 1 (trapezoidal rule, a
+        symmetric method whose global error expands in even powers of h: Hairer,
+        Nørsett & Wanner, Solving ODEs I, sect. II.8) the error falls from O(h²) to
+        O(h⁴) for three times the work; the combination still satisfies the equation of
+        motion at the grid points (weights summing to 1, linear equations). Worth it near
+        resonances, where the O(h²) frequency error of the integrator shifts the
+        resonance peak (benchmarks/response.py: 1.4 % at 512 steps, 3e-4 extrapolated).
+        For ρ∞ < 1 the gain is one order only.
 
     Returns
     -------
@@ -275,6 +286,12 @@ def periodic_steady_state(system, Omega: float, n_steps: int = 512, rho_inf: flo
         raise ValueError(f"drive speed Omega must be positive, got {Omega} rad/s")
     if int(n_steps) != n_steps or n_steps < 2:
         raise ValueError(f"n_steps must be an integer >= 2, got {n_steps}")
+    if richardson:
+        coarse = periodic_steady_state(system, Omega, n_steps, rho_inf, angle_period, phi0)
+        fine = periodic_steady_state(system, Omega, 2 * int(n_steps), rho_inf, angle_period,
+                                     phi0)
+        combined = [(4 * getattr(fine, k)[::2] - getattr(coarse, k)) / 3 for k in "qva"]
+        return Response(coarse.t, *combined, coarse.phi)
     t = np.linspace(0.0, angle_period / Omega, int(n_steps) + 1)
     drive = ConstantSpeed(Omega, phi0)
     matrices_at = _matrices(system, *drive(t))
@@ -306,6 +323,21 @@ def rayleigh_damping(system: CoupledSystem, mass_coef: float,
     """
     B0 = system.B0 + mass_coef * system.M0 + stiffness_coef * system.K0
     return replace(system, B0=B0)
+
+
+def rayleigh_coefficients(zeta: float, f1_hz: float, f2_hz: float) -> tuple[float, float]:
+    """Rayleigh coefficients (a in 1/s, b in s) giving the damping ratio ζ at f1 and f2.
+
+    From ζ(ω) = a/(2ω) + bω/2 at ω₁ = 2π f1 and ω₂ = 2π f2: a = 2ζ ω₁ω₂/(ω₁ + ω₂),
+    b = 2ζ/(ω₁ + ω₂) (Chopra, Dynamics of Structures, 4th ed., eq. 11.4.9); between f1 and
+    f2 the ratio is slightly below ζ, outside it grows.
+    """
+    if not (np.isfinite(zeta) and zeta >= 0):
+        raise ValueError(f"damping ratio zeta must be >= 0, got {zeta}")
+    if not (0 < f1_hz < f2_hz < np.inf):
+        raise ValueError(f"need 0 < f1_hz < f2_hz, got f1_hz = {f1_hz}, f2_hz = {f2_hz}")
+    w1, w2 = 2 * np.pi * f1_hz, 2 * np.pi * f2_hz
+    return 2 * zeta * w1 * w2 / (w1 + w2), 2 * zeta / (w1 + w2)
 
 
 def frame_history(system: CoupledSystem, model, q_history, dofs) -> np.ndarray:

@@ -44,6 +44,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
+from femmech.analysis.response import rayleigh_coefficients, rayleigh_damping
+from femmech.analysis.sweep import sweep
 from femmech.coupling import CoupledSystem, assemble_at, require_dense_primal
 
 GAUSS_OFFSETS = np.array([0.5 - np.sqrt(3.0) / 6.0, 0.5 + np.sqrt(3.0) / 6.0])
@@ -101,6 +103,8 @@ class StabilityChart:
     tol : float
     parameter_name : str
         Label of the second parameter (with its unit).
+    periods : ndarray (n_values, n_speeds) or None
+        Period T of each point, s (Θ/Ω for coupled systems).
     """
 
     speeds: np.ndarray
@@ -109,6 +113,20 @@ class StabilityChart:
     stable: np.ndarray
     tol: float
     parameter_name: str = "parameter"
+    periods: np.ndarray | None = None
+
+    @property
+    def growth_rate(self) -> np.ndarray:
+        """Largest real part of the characteristic exponents, ln(max|μ|)/T, 1/s.
+
+        Unlike the spectral radius, which falls towards 0 at low speed only because the
+        period grows, it is the decay rate −ζω of the least damped free motion of a
+        time-invariant system, so parametric resonances stand out as bumps towards and
+        above 0 (unstable) at any speed.
+        """
+        if self.periods is None:
+            raise ValueError("this chart has no periods; build it with stability_chart")
+        return np.log(np.maximum(self.spectral_radius, 1e-300)) / self.periods
 
 
 def first_order_matrices(M, B, C) -> np.ndarray:
@@ -223,7 +241,8 @@ def floquet(Phi, period: float, tol: float = 1e-6) -> Floquet:
 
 
 def coupled_monodromy(system: CoupledSystem, Omega: float, n_steps: int = 256,
-                      angle_period: float = 2 * np.pi, phi0: float = 0.0) -> np.ndarray:
+                      angle_period: float = 2 * np.pi, phi0: float = 0.0,
+                      basis: np.ndarray | None = None) -> np.ndarray:
     """Monodromy matrix of a coupled machine running at constant drive speed Ω.
 
     The drive angle is φ = φ₀ + Ω t, so the period is T = Θ/Ω with Θ = ``angle_period``
@@ -245,39 +264,127 @@ def coupled_monodromy(system: CoupledSystem, Omega: float, n_steps: int = 256,
         Θ, rad.
     phi0 : float
         Drive angle at t = 0, rad (the multipliers do not depend on it).
+    basis : ndarray (n, r), optional
+        Constant Ritz basis V (e.g. :func:`quasi_modal_basis`): the motion is sought as
+        x = V y and the equations are projected, Vᵀ M V y'' + Vᵀ B V y' + Vᵀ C V y = 0.
+        This keeps the r slow coupled modes that can be parametrically excited in the
+        speed range and drops the stiff residual-vector and high frame modes, whose
+        exponentials dominate the cost (about (2n)³ per step); the user chooses r.
 
     Returns
     -------
-    ndarray (2n, 2n)
-        Φ(T) for ``z = [x; x']`` in the system's global coordinates x.
+    ndarray (2n, 2n) or (2r, 2r)
+        Φ(T) for ``z = [x; x']`` in the system's global coordinates x, or for
+        ``z = [y; y']`` with a basis.
 
     Raises
     ------
     ValueError
-        For an unreduced (sparse) frame, the multiplier form, or Ω <= 0.
+        For an unreduced (sparse) frame, the multiplier form, Ω <= 0 or a bad basis.
     """
     require_dense_primal(system, "coupled_monodromy")
     if not (np.isfinite(Omega) and Omega > 0):
         raise ValueError(f"drive speed Omega must be positive, got {Omega} rad/s")
+    V = None if basis is None else _checked_basis(basis, system.n)
 
     def coefficients(t):
         blocks = system.mechanism_blocks(phi0 + Omega * t, Omega)
         mats = [assemble_at(system, blocks, k)[:3] for k in range(t.size)]
-        return tuple(np.stack([m[i] for m in mats]) for i in range(3))
+        stacks = tuple(np.stack([m[i] for m in mats]) for i in range(3))
+        return stacks if V is None else tuple(V.T @ X @ V for X in stacks)
 
     return _magnus_monodromy(coefficients, angle_period / Omega, n_steps)
 
 
 def coupled_floquet(system: CoupledSystem, Omega: float, n_steps: int = 256,
-                    angle_period: float = 2 * np.pi, tol: float = 1e-6) -> Floquet:
+                    angle_period: float = 2 * np.pi, tol: float = 1e-6,
+                    basis: np.ndarray | None = None) -> Floquet:
     """:func:`floquet` of :func:`coupled_monodromy` (period Θ/Ω)."""
-    Phi = coupled_monodromy(system, Omega, n_steps, angle_period)
+    Phi = coupled_monodromy(system, Omega, n_steps, angle_period, basis=basis)
     return floquet(Phi, angle_period / Omega, tol)
+
+
+def _checked_basis(basis, n: int) -> np.ndarray:
+    V = np.asarray(basis, dtype=float)
+    if V.ndim != 2 or V.shape[0] != n or not 0 < V.shape[1] <= n:
+        raise ValueError(f"basis must have shape ({n}, r) with 0 < r <= {n}, got {V.shape}")
+    if not np.isfinite(V).all():
+        raise ValueError("basis contains NaN or inf")
+    s = np.linalg.svd(V, compute_uv=False)
+    if s[-1] <= 1e-10 * s[0]:
+        raise ValueError(f"basis columns are linearly dependent (singular values"
+                         f" {s[0]:.3e} ... {s[-1]:.3e})")
+    return V
+
+
+def quasi_modal_basis(system: CoupledSystem, n_modes: int, n_angles: int = 8,
+                      angle_period: float = 2 * np.pi, rtol: float = 1e-8) -> np.ndarray:
+    """Ritz basis of the lowest coupled quasi-modes at several drive angles.
+
+    The undamped quasi-modes (Ω = 0) of the ``n_modes`` lowest branches at ``n_angles``
+    equally spaced angles over the cycle Θ are stacked and orthonormalised (SVD; columns
+    with singular values below ``rtol`` times the largest are dropped), so that the
+    basis spans every position's low modes. Use it with :func:`coupled_monodromy`,
+    :func:`coupled_floquet` or :func:`stability_chart` (``basis=``) to compute the
+    Floquet multipliers of the slow motion only; check convergence by increasing
+    ``n_modes`` (tests/test_stability.py shows the spectral radius converging).
+
+    Returns
+    -------
+    ndarray (n, r), r <= n_modes · n_angles
+        Orthonormal columns (Euclidean) in the system's global coordinates.
+    """
+    if int(n_modes) != n_modes or not 1 <= n_modes <= system.n:
+        raise ValueError(f"n_modes must be an integer in 1..{system.n}, got {n_modes}")
+    if int(n_angles) != n_angles or n_angles < 1:
+        raise ValueError(f"n_angles must be a positive integer, got {n_angles}")
+    phi = np.arange(int(n_angles)) * (angle_period / n_angles)
+    result = sweep(system, phi, n_modes=int(n_modes), track=False, keep_vectors=True)
+    stacked = np.concatenate(list(result.vectors), axis=1)
+    U, s, _ = np.linalg.svd(stacked / np.linalg.norm(stacked, axis=0), full_matrices=False)
+    return U[:, s > rtol * s[0]]
+
+
+def resonance_speeds(freq_hz, orders=(1, 2, 3), kind: str = "parametric",
+                     within: tuple[float, float] | None = None) -> dict:
+    """Predicted resonance speeds of a machine whose coefficients repeat every revolution.
+
+    A harmonic j of the drive speed Ω excites a mode of circular frequency ω_k
+    parametrically near j Ω = 2 ω_k (principal parametric resonance) and as a forced
+    vibration near j Ω = ω_k (Nayfeh & Mook, Nonlinear Oscillations, 1979, sect. 5.4;
+    Dresig & Holzweißig, Maschinendynamik, ch. 6 on parametric excitation).
+
+    Parameters
+    ----------
+    freq_hz : array_like (n_modes,)
+        Representative (e.g. angle-averaged) quasi-eigenfrequencies, Hz.
+    orders : sequence of int
+        Harmonic orders j.
+    kind : {"parametric", "forced"}
+    within : (float, float), optional
+        Keep only speeds in this range, rad/s (e.g. the chart's speed range).
+
+    Returns
+    -------
+    dict
+        ``{"2f1/1": Ω, ...}`` (or ``"f1/1"``), Ω in rad/s.
+    """
+    if kind not in ("parametric", "forced"):
+        raise ValueError(f"kind must be 'parametric' or 'forced', got {kind!r}")
+    factor, label = (2.0, "2f") if kind == "parametric" else (1.0, "f")
+    marks = {}
+    for k, f in enumerate(np.atleast_1d(np.asarray(freq_hz, dtype=float)), start=1):
+        for j in orders:
+            speed = factor * 2 * np.pi * f / j
+            if within is None or within[0] <= speed <= within[1]:
+                marks[f"{label}{k}/{j}"] = speed
+    return marks
 
 
 def stability_chart(system_or_callable, speeds, second_parameter_values=None,
                     n_steps: int = 256, angle_period: float = 2 * np.pi, tol: float = 1e-6,
-                    parameter_name: str = "parameter") -> StabilityChart:
+                    parameter_name: str = "parameter",
+                    basis: np.ndarray | None = None) -> StabilityChart:
     """Spectral radius of the monodromy matrix over drive speed (and a second parameter).
 
     Parameters
@@ -295,6 +402,9 @@ def stability_chart(system_or_callable, speeds, second_parameter_values=None,
         As in :func:`coupled_monodromy` and :func:`floquet`.
     parameter_name : str
         Label of the second parameter for plots, with its unit.
+    basis : ndarray (n, r), optional
+        Ritz basis for coupled systems (:func:`coupled_monodromy`); the same for every
+        point of the chart.
 
     Returns
     -------
@@ -321,15 +431,20 @@ def stability_chart(system_or_callable, speeds, second_parameter_values=None,
                         f" {type(system_or_callable).__name__}")
     rows = [None] if values is None else values
     radius = np.zeros((len(rows), speeds.size))
+    periods = np.zeros_like(radius)
     for i, p in enumerate(rows):
         for j, W in enumerate(speeds):
-            radius[i, j] = _radius(build(W, p), W, n_steps, angle_period)
-    return StabilityChart(speeds, values, radius, radius <= 1.0 + tol, tol, parameter_name)
+            radius[i, j], periods[i, j] = _radius(build(W, p), W, n_steps, angle_period,
+                                                  basis)
+    return StabilityChart(speeds, values, radius, radius <= 1.0 + tol, tol, parameter_name,
+                          periods)
 
 
-def _radius(model, Omega, n_steps, angle_period) -> float:
+def _radius(model, Omega, n_steps, angle_period, basis=None) -> tuple[float, float]:
+    """(spectral radius, period T in s) of one chart point."""
     if isinstance(model, CoupledSystem):
-        Phi = coupled_monodromy(model, Omega, n_steps, angle_period)
+        period = angle_period / Omega
+        Phi = coupled_monodromy(model, Omega, n_steps, angle_period, basis=basis)
     else:
         try:
             M_of_t, B_of_t, C_of_t, period = model
@@ -337,4 +452,80 @@ def _radius(model, Omega, n_steps, angle_period) -> float:
             raise TypeError("the callable must return a CoupledSystem or a tuple (M_of_t,"
                             f" B_of_t, C_of_t, period); got {type(model).__name__}") from None
         Phi = monodromy(M_of_t, B_of_t, C_of_t, period, n_steps)
-    return float(np.abs(sla.eigvals(Phi)).max())
+    return float(np.abs(sla.eigvals(Phi)).max()), float(period)
+
+
+@dataclass(frozen=True)
+class SpeedStudy:
+    """Floquet stability of a coupled machine over drive speed and frame damping.
+
+    Attributes
+    ----------
+    line : StabilityChart
+        Over speed at the nominal frame damping ratio.
+    chart : StabilityChart or None
+        Over speed and the frame damping ratio (``None`` without ratios).
+    marks : dict
+        Predicted principal parametric resonances ``{"2f1/j": Ω}`` (rad/s) in the range.
+    mean_freq_hz : ndarray (n_branches,)
+        Angle-averaged quasi-eigenfrequencies of the marked branches, Hz.
+    basis_size : int
+        Columns of the Ritz basis used for the monodromy matrices.
+    """
+
+    line: StabilityChart
+    chart: StabilityChart | None
+    marks: dict
+    mean_freq_hz: np.ndarray
+    basis_size: int
+
+
+def speed_study(system: CoupledSystem, speeds, zeta: float, band_hz: tuple[float, float],
+                damping_ratios=None, n_steps: int = 128, basis_modes: int = 8,
+                marked_branches: int = 2, orders=range(1, 13),
+                angle_period: float = 2 * np.pi) -> SpeedStudy:
+    """Stability of a machine over speed, with Rayleigh frame damping, in one call.
+
+    ``system`` carries the mechanisms' own damping but no frame damping; the frame gets
+    Rayleigh damping of ratio ζ at both ends of ``band_hz``
+    (:func:`~femmech.analysis.response.rayleigh_coefficients`). The monodromy matrices use
+    the Ritz basis of the ``basis_modes`` lowest quasi-modes (:func:`quasi_modal_basis`,
+    built once at the nominal damping), and the predicted resonance speeds 2 f_k / j of the
+    ``marked_branches`` lowest branches (angle-averaged over 36 angles) are returned for
+    the plots.
+
+    Parameters
+    ----------
+    system : CoupledSystem
+    speeds : array_like (n_speeds,)
+        Drive speeds, rad/s.
+    zeta : float
+        Nominal frame damping ratio (-).
+    band_hz : (float, float)
+        Frequencies where the Rayleigh damping ratio equals ζ, Hz.
+    damping_ratios : array_like, optional
+        Frame damping ratios of the two-parameter chart.
+    n_steps, basis_modes, angle_period
+        As in :func:`coupled_monodromy` and :func:`quasi_modal_basis`.
+    marked_branches : int
+    orders : sequence of int
+        Harmonic orders j of the marks.
+    """
+    speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
+
+    def damped(ratio):
+        return rayleigh_damping(system, *rayleigh_coefficients(ratio, *band_hz))
+
+    nominal = damped(zeta)
+    basis = quasi_modal_basis(nominal, basis_modes, angle_period=angle_period)
+    phi = np.linspace(0.0, angle_period, 36, endpoint=False)
+    mean_hz = sweep(nominal, phi, n_modes=marked_branches).freq_hz.mean(axis=0)
+    marks = resonance_speeds(mean_hz, orders, within=(speeds.min(), speeds.max()))
+    line = stability_chart(nominal, speeds, n_steps=n_steps, angle_period=angle_period,
+                           basis=basis)
+    chart = None
+    if damping_ratios is not None:
+        chart = stability_chart(lambda W, ratio: damped(ratio), speeds, damping_ratios,
+                                n_steps=n_steps, angle_period=angle_period,
+                                parameter_name="frame damping ratio ζ (-)", basis=basis)
+    return SpeedStudy(line, chart, marks, mean_hz, basis.shape[1])

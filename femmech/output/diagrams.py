@@ -73,20 +73,29 @@ def write_sweep_json(sweep, filename, metadata: dict | None = None) -> Path:
 
 
 def plot_stability_chart(chart, filename, title: str = "Floquet stability",
-                         speed_label: str = "drive speed Ω (rad/s)",
-                         marks: dict | None = None) -> Path:
+                         speed_label: str | None = None,
+                         marks: dict | None = None, quantity: str = "radius",
+                         speed_unit: str = "rad/s") -> Path:
     """Draw a :class:`~femmech.analysis.stability.StabilityChart` as a PNG.
 
     With a second parameter: the (speed, parameter) plane with the unstable regions
     (spectral radius > 1 + tol, parametric resonances) shaded and the boundary drawn.
-    Without: the spectral radius over speed (log scale) with unstable speed ranges
-    shaded. ``marks`` ({label: speed}) adds labelled vertical lines, e.g. the predicted
-    resonance speeds 2ω_k/j.
+    Without: over speed, the spectral radius (log scale, ``quantity="radius"``) or the
+    growth rate ln(max|μ|)/T in 1/s (``quantity="growth_rate"``, where resonances show
+    as bumps at any speed), with unstable speed ranges shaded. ``marks``
+    ({label: speed}) adds labelled vertical lines, e.g. the predicted resonance speeds
+    2ω_k/j, in rad/s like the chart. ``speed_unit`` ("rad/s", "Hz" or "rpm") is the unit
+    of the speed axis; ``speed_label`` overrides its label.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    speeds, radius = np.asarray(chart.speeds), np.asarray(chart.spectral_radius)
+    scales = {"rad/s": 1.0, "Hz": 1 / (2 * np.pi), "rpm": 60 / (2 * np.pi)}
+    if speed_unit not in scales:
+        raise ValueError(f"speed_unit must be one of {sorted(scales)}, got {speed_unit!r}")
+    scale = scales[speed_unit]
+    speed_label = speed_label or f"drive speed ({speed_unit})"
+    speeds, radius = scale * np.asarray(chart.speeds), np.asarray(chart.spectral_radius)
     unstable = ~np.asarray(chart.stable)
     if speeds.size < 2 or radius.shape != (radius.shape[0], speeds.size):
         raise ValueError(f"the chart needs >= 2 speeds and radii (n_values, {speeds.size}),"
@@ -94,23 +103,34 @@ def plot_stability_chart(chart, filename, title: str = "Floquet stability",
     fig = Figure(figsize=(7.0, 4.5), dpi=120)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
+    if quantity not in ("radius", "growth_rate"):
+        raise ValueError(f"quantity must be 'radius' or 'growth_rate', got {quantity!r}")
     if chart.values is None or len(chart.values) < 2:
-        ax.semilogy(speeds, np.maximum(radius[0], 1e-300), color="k", lw=1.2)
-        ax.axhline(1.0 + chart.tol, color="tab:red", lw=0.8, ls="--")
+        if quantity == "radius":
+            ax.semilogy(speeds, np.maximum(radius[0], 1e-300), color="k", lw=1.2)
+            ax.axhline(1.0 + chart.tol, color="tab:red", lw=0.8, ls="--")
+            ax.set_ylabel("spectral radius max|μ|")
+        else:
+            ax.plot(speeds, chart.growth_rate[0], color="k", lw=1.2)
+            ax.axhline(0.0, color="tab:red", lw=0.8, ls="--")
+            ax.set_ylabel("growth rate ln(max|μ|)/T (1/s)")
         edges = np.concatenate([[speeds[0]], 0.5 * (speeds[1:] + speeds[:-1]), [speeds[-1]]])
         for j in np.flatnonzero(unstable[0]):
             ax.axvspan(edges[j], edges[j + 1], color="tab:red", alpha=0.25, lw=0)
-        ax.set_ylabel("spectral radius max|μ|")
     else:
         values = np.asarray(chart.values)
+        if quantity == "growth_rate":
+            mesh = ax.pcolormesh(speeds, values, chart.growth_rate, shading="nearest",
+                                 cmap="viridis")
+            fig.colorbar(mesh, ax=ax, label="growth rate ln(max|μ|)/T (1/s)")
         ax.contourf(speeds, values, unstable.astype(float), levels=[0.5, 1.5],
                     colors=["tab:red"], alpha=0.35)
         ax.contour(speeds, values, np.log(np.maximum(radius, 1e-300)),
                    levels=[np.log1p(chart.tol)], colors=["tab:red"], linewidths=0.8)
         ax.set_ylabel(chart.parameter_name)
     for label, speed in (marks or {}).items():
-        ax.axvline(speed, color="0.3", lw=0.7, ls=":")
-        ax.annotate(str(label), (speed, 1.0), xycoords=("data", "axes fraction"),
+        ax.axvline(scale * speed, color="0.3", lw=0.7, ls=":")
+        ax.annotate(str(label), (scale * speed, 1.0), xycoords=("data", "axes fraction"),
                     xytext=(-2, -4), textcoords="offset points", rotation=90, va="top",
                     ha="right", fontsize=7)
     ax.set_xlabel(speed_label)
@@ -118,4 +138,95 @@ def plot_stability_chart(chart, filename, title: str = "Floquet stability",
     fig.tight_layout()
     with atomic_path(filename) as tmp:
         fig.savefig(tmp, format="png")
+    return Path(filename)
+
+
+def plot_time_histories(t, panels: dict, filename, title: str = "",
+                        xlabel: str = "time (s)") -> Path:
+    """Time histories in stacked panels sharing the time axis (PNG).
+
+    Parameters
+    ----------
+    t : array_like (n_t,)
+        Times (or drive angles: set ``xlabel``).
+    panels : dict
+        ``{y_label: {curve_label: values (n_t,)}}``, one panel per entry, top to bottom;
+        the y label carries the unit, e.g. ``"force (kN)"``.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    t = np.asarray(t, dtype=float)
+    if not panels:
+        raise ValueError("plot_time_histories needs at least one panel")
+    for ylabel, curves in panels.items():
+        for label, values in curves.items():
+            if np.shape(values) != t.shape:
+                raise ValueError(f"panel {ylabel!r}, curve {label!r}: expected {t.shape[0]}"
+                                 f" values (one per time), got shape {np.shape(values)}")
+    fig = Figure(figsize=(7.5, 1.0 + 2.0 * len(panels)), dpi=120)
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
+    for ax, (ylabel, curves) in zip(axes, panels.items(), strict=True):
+        for label, values in curves.items():
+            ax.plot(t, values, lw=1.0, label=label)
+        ax.set_ylabel(ylabel)
+        ax.grid(True, lw=0.3)
+        if len(curves) > 1:
+            ax.legend(fontsize=7, loc="upper right", ncols=min(4, len(curves)))
+    axes[-1].set_xlabel(xlabel)
+    if title:
+        axes[0].set_title(title)
+    fig.tight_layout()
+    with atomic_path(filename) as tmp:
+        fig.savefig(tmp, format="png")
+    return Path(filename)
+
+
+def plot_orbit(x, y, filename, xlabel: str = "x", ylabel: str = "y", title: str = "",
+               equal: bool = True) -> Path:
+    """Orbit y(x) of a periodic motion, e.g. a bearing centre over one cycle (PNG).
+
+    The start point is marked with a dot and the direction of travel with an arrow;
+    ``equal`` uses equal axis scales (displacements in the same unit).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if x.shape != y.shape or x.ndim != 1 or x.size < 3:
+        raise ValueError(f"x and y must be 1D with the same length >= 3, got {x.shape},"
+                         f" {y.shape}")
+    fig = Figure(figsize=(5.0, 5.0), dpi=120)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    ax.plot(x, y, color="k", lw=1.0)
+    ax.plot(x[0], y[0], "o", color="tab:red", ms=4)
+    k = max(1, x.size // 50)
+    ax.annotate("", xy=(x[k], y[k]), xytext=(x[0], y[0]),
+                arrowprops={"arrowstyle": "->", "color": "tab:red"})
+    if equal:
+        ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, lw=0.3)
+    if title:
+        ax.set_title(title)
+    fig.tight_layout()
+    with atomic_path(filename) as tmp:
+        fig.savefig(tmp, format="png")
+    return Path(filename)
+
+
+def write_history_csv(t, columns: dict, filename, time_label: str = "t_s") -> Path:
+    """Time histories as CSV: the time column, then one column per ``{name: values}``."""
+    t = np.asarray(t, dtype=float)
+    for name, values in columns.items():
+        if np.shape(values) != t.shape:
+            raise ValueError(f"column {name!r}: expected {t.shape[0]} values, got shape"
+                             f" {np.shape(values)}")
+    rows = np.column_stack([t, *[np.asarray(v, dtype=float) for v in columns.values()]])
+    with atomic_path(filename) as tmp:
+        np.savetxt(tmp, rows, delimiter=",", header=",".join([time_label, *columns]),
+                   comments="", fmt="%.10g")
     return Path(filename)
