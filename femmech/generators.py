@@ -74,3 +74,69 @@ def _subdivide(joints, members, k):
         n_points += len(inner)
         n_cells += m * k
     return np.concatenate(points), np.concatenate(cells), cell_sets
+
+
+MAX_ELEMENTS_PER_MEMBER = 100_000
+"""Guard against a unit slip (a length in mm given as m) exhausting the memory."""
+
+
+def members_frame(joints, members, node_sets=None) -> Mesh:
+    """Beam mesh from named joints and chains of members, each subdivided into elements.
+
+    Parameters
+    ----------
+    joints : dict[str, array_like (3,)]
+        Joint name → coordinates, m. Every joint becomes a node and a one-node node set
+        of its name.
+    members : sequence of dict
+        Each with ``group`` (cell-set name; several members may share one), ``chain``
+        (two or more joint names, consecutive joints joined by straight members) and
+        either ``element_size`` (m; ``max(1, round(length / element_size))`` elements
+        per member) or ``divisions`` (elements per member).
+    node_sets : dict[str, sequence of str], optional
+        Extra node sets made of joints (e.g. ``{"feet": ["left_foot", "right_foot"]}``).
+
+    Returns
+    -------
+    Mesh
+        Line cells; cell sets by group (in order of appearance), node sets per joint and
+        from ``node_sets``. Interior nodes follow the joints, member by member.
+
+    Raises
+    ------
+    ValueError
+        Naming an unknown joint, a member without length or a bad subdivision.
+    """
+    names = list(joints)
+    index = {name: i for i, name in enumerate(names)}
+    points = [np.array([joints[n] for n in names], dtype=float).reshape(-1, 3)]
+    n_points, lines, groups = len(names), [], {}
+    for m, member in enumerate(members):
+        chain = list(member["chain"])
+        unknown = [j for j in chain if j not in index]
+        if len(chain) < 2 or unknown:
+            raise ValueError(f"member {m} ({member['group']!r}): chain {chain} needs >= 2 known"
+                             f" joints; unknown: {unknown}")
+        for a, b in zip(chain[:-1], chain[1:], strict=True):
+            pa, pb = points[0][index[a]], points[0][index[b]]
+            length = float(np.linalg.norm(pb - pa))
+            if not (np.isfinite(length) and length > 0.0):
+                raise ValueError(f"member {m} ({member['group']!r}): joints {a!r} and {b!r}"
+                                 f" are {length} m apart")
+            k = member.get("divisions") or max(1, round(length / member["element_size"]))
+            if k > MAX_ELEMENTS_PER_MEMBER:
+                raise ValueError(f"member {m} ({member['group']!r}) from {a!r} to {b!r}: {k}"
+                                 f" elements (length {length:.6g} m); at most"
+                                 f" {MAX_ELEMENTS_PER_MEMBER} per member")
+            inner = pa + np.outer(np.arange(1, k) / k, pb - pa)
+            ids = np.concatenate([[index[a]], n_points + np.arange(k - 1), [index[b]]])
+            points.append(inner)
+            n_points += k - 1
+            first = sum(len(c) for c in lines)
+            lines.append(np.column_stack([ids[:-1], ids[1:]]))
+            groups.setdefault(member["group"], []).append(first + np.arange(k))
+    sets = {n: [i] for n, i in index.items()}
+    for name, members_of_set in (node_sets or {}).items():
+        sets[name] = [index[j] for j in members_of_set]
+    cell_sets = {g: np.concatenate(parts) for g, parts in groups.items()}
+    return Mesh.from_lines(np.vstack(points), np.vstack(lines), cell_sets, sets)

@@ -1,0 +1,300 @@
+"""From a validated :class:`~femmech.scene.Scene` to API objects: meshes, FE models,
+superelements, mechanism models and mounts.
+
+:func:`prepare` does everything that needs no FE computation (reads or generates the
+meshes, builds the mechanism models, checks every group name, node index and
+coordinate name) and is what ``femmech check`` runs; :func:`part_model`,
+:func:`reduce_part` and :func:`machine_mounts` are the computing steps that
+:mod:`femmech.scene_run` calls only when an analysis needs them. Errors of the API
+raised here are re-raised as one-line :class:`~femmech.errors.SceneError` naming the
+scene location.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+import femmech as fm
+from femmech import sections as sec
+from femmech.coupling import Attachment, Mount
+from femmech.dofs import COMPONENTS
+from femmech.errors import SceneError
+from femmech.generators import grid_frame, members_frame
+from femmech.model import node_index, node_indices
+from femmech.reduction import FORMAT_VERSION, craig_bampton, guyan
+from femmech.scene import PartSpec, Scene
+
+_ITEMS = {"support": fm.Support, "mass": fm.PointMass, "spring": fm.Spring,
+          "rigid_link": fm.RigidLink, "interpolating_link": fm.InterpolatingLink}
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """A scene with its meshes and mechanism models, all references checked.
+
+    Attributes
+    ----------
+    scene : Scene
+    meshes : dict[str, Mesh]
+        Per part.
+    mechanisms : dict[str, RheolinearModel]
+        Per mechanism.
+    keys : dict[str, str]
+        Per part with a reduction: SHA-256 of everything its reduction depends on (see
+        :func:`reduction_key_data`).
+    """
+
+    scene: Scene
+    meshes: dict
+    mechanisms: dict
+    keys: dict
+
+
+def fail(scene: Scene, where: str, key: str | None, message: str) -> SceneError:
+    """A SceneError at ``[where] key`` of the scene file."""
+    place = f"[{where}]" + (f" {key}" if key else "")
+    return SceneError(f"{scene.file}: {place}: {message}".replace("\n", " "))
+
+
+def prepare(scene: Scene) -> Prepared:
+    """Read/generate meshes and build mechanisms; check all references (no FE assembly)."""
+    from femmech.scene_mechanisms import mechanism_model
+
+    meshes = {name: part_mesh(scene, part) for name, part in scene.parts.items()}
+    for name, part in scene.parts.items():
+        check_part(scene, part, meshes[name])
+    models = {name: mechanism_model(scene, spec) for name, spec in scene.mechanisms.items()}
+    for mount in scene.mounts:
+        _check_mount(scene, mount, meshes[mount.part], models[mount.mechanism])
+    _check_outputs(scene, models)
+    keys = {name: sha256_key(reduction_key_data(scene, part))
+            for name, part in scene.parts.items() if part.reduction is not None}
+    return Prepared(scene, meshes, models, keys)
+
+
+def part_mesh(scene: Scene, part: PartSpec) -> fm.Mesh:
+    """The part's mesh: read from its file or generated; edge groups turned into nodes."""
+    spec = part.mesh
+    try:
+        if spec.file is not None:
+            mesh = fm.read_mesh(spec.file)
+        elif spec.generator == "grid_frame":
+            mesh = grid_frame(**spec.params)
+        else:
+            mesh = members_frame(**spec.params)
+        return edges_to_node_sets(mesh, spec.edge_node_groups)
+    except (ValueError, FileNotFoundError) as exc:
+        key = "mesh" if spec.file is not None else None
+        raise fail(scene, spec.where, key, str(exc)) from None
+
+
+def edges_to_node_sets(mesh: fm.Mesh, names) -> fm.Mesh:
+    """Mesh without the line cells of the groups ``names``, which become node sets (a Gmsh
+    physical curve that marks nodes, e.g. a bearing bore, rather than beams)."""
+    if not names:
+        return mesh
+    lines = mesh.cells.get("line", np.empty((0, 2), dtype=np.int64))
+    drop = np.zeros(len(lines), dtype=bool)
+    node_sets = dict(mesh.node_sets)
+    for name in names:
+        idx = mesh.cell_sets.get(name, {}).get("line")
+        if idx is None or set(mesh.cell_sets[name]) != {"line"}:
+            line_groups = sorted(n for n, s in mesh.cell_sets.items() if "line" in s)
+            raise ValueError(f"edge_node_groups: {name!r} is not a group of line cells; line"
+                             f" groups: {line_groups}")
+        drop[idx] = True
+        node_sets[name] = np.unique(lines[idx])
+    new = np.cumsum(~drop) - 1
+    cell_sets = {}
+    for name, by_type in mesh.cell_sets.items():
+        if name not in names:
+            by_type = dict(by_type)
+            if "line" in by_type:
+                by_type["line"] = new[by_type["line"][~drop[by_type["line"]]]]
+            cell_sets[name] = by_type
+    return fm.Mesh(mesh.points, {**mesh.cells, "line": lines[~drop]}, cell_sets, node_sets)
+
+
+def check_part(scene: Scene, part: PartSpec, mesh: fm.Mesh) -> None:
+    """Group names of properties and node references of items and interface exist."""
+    for prop in (*part.sections, *part.shells, *part.solids):
+        if prop.group not in mesh.cell_sets:
+            raise fail(scene, prop.where, None, f"group {prop.group!r} is not a cell group of"
+                       f" the mesh; expected one of {sorted(mesh.cell_sets)}")
+    lines = mesh.cells.get("line", np.empty((0, 2)))
+    owned = np.zeros(len(lines), dtype=bool)
+    for prop in part.sections:
+        owned[mesh.cell_sets[prop.group].get("line", [])] = True
+    if not owned.all():
+        e = int(np.flatnonzero(~owned)[0])
+        groups = [n for n, s in mesh.cell_sets.items() if e in s.get("line", ())]
+        raise fail(scene, part.where, "sections", f"line element {e} has no section"
+                   f" ({np.count_nonzero(~owned)} such elements); its groups: {groups}")
+    for item in part.items:
+        for key, value in item.values.items():
+            if key in ("node", "node_a", "master", "reference") or (
+                    key == "node_b" and value is not None):
+                _resolve(scene, mesh, value, item.where, key, one=True)
+            elif key in ("nodes", "slaves", "patch"):
+                _resolve(scene, mesh, value, item.where, key, one=False)
+    for item in (part.reduction.interface if part.reduction else ()):
+        _resolve(scene, mesh, item.nodes, item.where, "nodes", one=False)
+
+
+def _resolve(scene, mesh, ref, where, key, one: bool):
+    try:
+        return node_index(mesh, ref, key) if one else node_indices(mesh, ref, key)
+    except (ValueError, TypeError) as exc:
+        message = str(exc).removeprefix(f"{key}: ")
+        raise fail(scene, where, key, message) from None
+
+
+def _check_mount(scene, mount, mesh, model) -> None:
+    names = model.coordinate_names
+    for att in mount.attachments:
+        if att.coordinate not in names:
+            raise fail(scene, att.where, "coordinate", f"expected one of the coordinates"
+                       f" {list(names)} of mechanism {mount.mechanism!r}, got"
+                       f" {att.coordinate!r}")
+        _resolve(scene, mesh, att.node, att.where, "node", one=True)
+        if isinstance(att.direction, str) and att.direction not in COMPONENTS:
+            raise fail(scene, att.where, "direction", f"expected one of"
+                       f" {list(COMPONENTS)} or six weights, got {att.direction!r}")
+
+
+def own_coordinates(scene: Scene, models: dict) -> list[str]:
+    """Labels ``"mount.coordinate"`` of the coupled machine's own (not rigidly attached)
+    mechanism coordinates, as in :attr:`femmech.coupling.CoupledSystem.labels`."""
+    out = []
+    for mount in scene.mounts:
+        rigid = {a.coordinate for a in mount.attachments if a.stiffness is None}
+        out += [f"{mount.name}.{c}" for c in models[mount.mechanism].coordinate_names
+                if c not in rigid]
+    return out
+
+
+def _check_outputs(scene: Scene, models: dict) -> None:
+    spec = scene.analyses.response
+    if spec is None:
+        return
+    own = own_coordinates(scene, models)
+    for name in spec.outputs:
+        if name not in own:
+            raise fail(scene, scene.analyses.where["response"], "outputs",
+                       f"expected labels of the machine's own coordinates {own}, got {name!r}")
+
+
+def part_model(scene: Scene, part: PartSpec, mesh: fm.Mesh) -> fm.FEModel:
+    """:func:`femmech.build_model` of the part (assembly of K and M)."""
+    mats = {n: fm.Material(E=m.E, rho=m.rho, nu=m.nu, G=m.G, name=n)
+            for n, m in scene.materials.items()}
+    beams, shells, solids = {}, {}, {}
+    for s in part.sections:
+        section = _section(s)
+        beams[s.group] = fm.BeamProperty(section, mats[s.material], s.orientation, s.shear,
+                                         s.rotary_inertia)
+    for s in part.shells:
+        shells[s.group] = fm.ShellProperty(s.thickness, mats[s.material])
+    for s in part.solids:
+        solids[s.group] = fm.SolidProperty(mats[s.material])
+    lists = {kind: [] for kind in _ITEMS}
+    for item in part.items:
+        lists[item.kind].append(_ITEMS[item.kind](**item.values))
+    try:
+        return fm.build_model(mesh, beams, masses=lists["mass"], springs=lists["spring"],
+                              supports=lists["support"], rigid_links=lists["rigid_link"],
+                              interpolating_links=lists["interpolating_link"],
+                              shells=shells or None, solids=solids or None)
+    except (ValueError, TypeError) as exc:
+        raise fail(scene, part.where, None, str(exc)) from None
+
+
+def _section(s) -> fm.BeamSection:
+    dims = dict(s.dims)
+    factory = getattr(sec, s.shape)
+    return factory(**dims, name=s.group)
+
+
+def interface(part: PartSpec) -> list:
+    """The interface in the form of :func:`femmech.reduction.interface_dofs`."""
+    return [(i.nodes if isinstance(i.nodes, (str, int)) else list(i.nodes), i.dofs)
+            for i in part.reduction.interface]
+
+
+def reduce_part(scene: Scene, part: PartSpec, model: fm.FEModel, f_max_hz: float | None = None):
+    """Guyan or Craig-Bampton superelement of the part (``f_max_hz`` overrides the
+    scene's mode selection, for the speed-versus-error comparison)."""
+    r = part.reduction
+    try:
+        if r.method == "guyan":
+            return guyan(model, interface(part))
+        if f_max_hz is not None:
+            return craig_bampton(model, interface(part), f_max_hz=f_max_hz,
+                                 residual_vectors=r.residual_vectors)
+        return craig_bampton(model, interface(part), n_modes=r.n_modes, cutoff_hz=r.cutoff_hz,
+                             f_max_hz=r.f_max_hz, residual_vectors=r.residual_vectors)
+    except ValueError as exc:
+        raise fail(scene, r.where, "interface", str(exc)) from None
+
+
+def reduction_key_data(scene: Scene, part: PartSpec, f_max_hz: float | None = None) -> dict:
+    """Everything a part's reduction depends on, as plain JSON data: the mesh file's
+    content (SHA-256) or the generator parameters, the materials the part uses, its
+    properties, items, interface and reduction settings, the femmech version and the
+    superelement file format. The part's name and file paths are not part of it."""
+    mesh = plain(part.mesh)
+    if part.mesh.file is not None:
+        mesh["file"] = hashlib.sha256(Path(part.mesh.file).read_bytes()).hexdigest()
+    reduction = plain(part.reduction)
+    if f_max_hz is not None:
+        reduction.update(n_modes=None, cutoff_hz=None, f_max_hz=float(f_max_hz))
+    return {"femmech": fm.__version__, "format": FORMAT_VERSION, "mesh": mesh,
+            "materials": {n: plain(scene.materials[n]) for n in part.materials_used()},
+            "sections": plain(part.sections), "shells": plain(part.shells),
+            "solids": plain(part.solids), "items": plain(part.items), "reduction": reduction}
+
+
+def plain(obj):
+    """JSON-able copy of nested dataclasses, dicts and sequences (fields with
+    ``compare=False``, i.e. scene locations, left out)."""
+    if dataclasses.is_dataclass(obj):
+        return {f.name: plain(getattr(obj, f.name)) for f in dataclasses.fields(obj)
+                if f.compare}
+    if isinstance(obj, dict):
+        return {str(k): plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [plain(v) for v in obj]
+    if isinstance(obj, (np.floating, np.integer)):
+        return obj.item()
+    return obj
+
+
+def sha256_key(data) -> str:
+    """SHA-256 (hex) of JSON data, independent of key order."""
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def machine_mounts(prepared: Prepared, part_index: dict | None = None) -> list[Mount]:
+    """The scene's mounts as API objects; nodes resolved to indices, as
+    ``(part_index, node)`` pairs when ``part_index`` ({part name: index}) is given."""
+    scene = prepared.scene
+    out = []
+    for m in scene.mounts:
+        mesh = prepared.meshes[m.part]
+        atts = []
+        for a in m.attachments:
+            node = node_index(mesh, a.node, "attachment")
+            if part_index is not None:
+                node = (part_index[m.part], node)
+            atts.append(Attachment(a.coordinate, node, a.direction, a.stiffness, a.damping))
+        out.append(Mount(prepared.mechanisms[m.mechanism], tuple(atts), m.ratio, m.phase,
+                         m.name))
+    return out
+

@@ -1,0 +1,122 @@
+"""The ``femmech`` command: ``run`` and ``check``, exit codes and one-line errors (issue 8)."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from femmech.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+
+SCENE = """
+[scene]
+name = "cli test"
+
+[materials.steel]
+E = "210 GPa"
+nu = 0.3
+rho = "7850 kg/m^3"
+
+[parts.frame.generator]
+kind = "grid_frame"
+bays = [1, 1, 1]
+size = [1.0, 0.6, 0.8]
+subdivisions = 2
+
+[parts.frame.sections]
+beams_x = { section = "circle", diameter = "40 mm", material = "steel" }
+beams_y = { section = "circle", diameter = "40 mm", material = "steel" }
+columns = { section = "circle", diameter = "50 mm", material = "steel" }
+
+[[parts.frame.supports]]
+nodes = "base"
+
+[parts.frame.reduction]
+method = "craig_bampton"
+n_modes = 6
+interface = [{ nodes = "top", dofs = "translations" }]
+
+[analyses.modes]
+n_modes = 4
+images = 0
+vtu = false
+"""
+
+
+@pytest.fixture
+def scene(tmp_path) -> Path:
+    path = tmp_path / "frame.toml"
+    path.write_text(SCENE)
+    return path
+
+
+@pytest.fixture
+def bad_scene(tmp_path) -> Path:
+    path = tmp_path / "bad.toml"
+    path.write_text(SCENE.replace('nodes = "base"', 'nodes = "base"\nfixed = true'))
+    return path
+
+
+def test_check_valid_scene(scene, capsys):
+    assert main(["check", str(scene)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("frame.toml: OK: parts frame (")
+    assert "analyses ['modes']" in out
+
+
+def test_check_bad_scene_exit_2_with_one_line(bad_scene, capsys):
+    assert main(["check", str(bad_scene)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert err.startswith("error: bad.toml: [parts.frame.supports[0]] fixed: unknown key;"
+                          " expected one of ['dofs', 'nodes']")
+
+
+def test_check_missing_scene(tmp_path, capsys):
+    assert main(["check", str(tmp_path / "nowhere.toml")]) == 2
+    assert "nowhere.toml: scene file not found" in capsys.readouterr().err
+
+
+def test_run_bad_scene_exit_2(bad_scene, tmp_path, capsys):
+    assert main(["run", str(bad_scene), "--out", str(tmp_path / "out"), "--no-cache"]) == 2
+    assert "unknown key" in capsys.readouterr().err
+    assert not (tmp_path / "out" / "report.html").exists()
+
+
+def test_usage_errors_exit_2(capsys):
+    with pytest.raises(SystemExit) as info:
+        main([])
+    assert info.value.code == 2
+    with pytest.raises(SystemExit) as info:
+        main(["run", "scene.toml"])  # --out is required
+    assert info.value.code == 2
+
+
+def test_run_writes_report_and_reuses_cache(scene, tmp_path, capsys):
+    cache = tmp_path / "cache"
+    args = ["run", str(scene), "--cache-dir", str(cache)]
+    assert main([*args, "--out", str(tmp_path / "a")]) == 0
+    out = capsys.readouterr().out
+    assert "cache miss: part 'frame'" in out
+    assert main([*args, "--out", str(tmp_path / "b"), "--quiet"]) == 0
+    assert capsys.readouterr().out.strip() == str(tmp_path / "b" / "report.html")
+    assert "cache hit: part 'frame'" in (tmp_path / "b" / "run.log").read_text()
+    for name in ("report.html", "results.json", "frequencies.csv"):
+        assert (tmp_path / "b" / name).is_file()
+    assert main(["run", str(scene), "--out", str(tmp_path / "c"), "--no-cache", "-q"]) == 0
+    assert "cache off: part 'frame'" in (tmp_path / "c" / "run.log").read_text()
+    assert not list((tmp_path / "c").glob("*.npz"))
+
+
+def test_module_entry_point_exit_codes(scene, bad_scene):
+    # what the installed `femmech` script runs ([project.scripts] femmech = femmech.cli:main)
+    ok = subprocess.run([sys.executable, "-m", "femmech", "check", str(scene)], cwd=ROOT,
+                        capture_output=True, text=True, timeout=120, check=False)
+    assert ok.returncode == 0, ok.stderr
+    bad = subprocess.run([sys.executable, "-m", "femmech", "check", str(bad_scene)], cwd=ROOT,
+                         capture_output=True, text=True, timeout=120, check=False)
+    assert bad.returncode == 2
+    assert bad.stderr.count("\n") == 1
+    assert bad.stderr.startswith("error: bad.toml: ")
