@@ -47,7 +47,7 @@ import scipy.linalg as sla
 
 import femmech as fm
 from femmech import sections
-from femmech.analysis.forces import attachment_forces, drive_forces
+from femmech.analysis.forces import attachment_forces, beam_section_forces, drive_forces
 from femmech.analysis.reference import compare_coupled
 from femmech.analysis.response import (
     ConstantSpeed,
@@ -70,7 +70,7 @@ from femmech.mechanisms import (
 from femmech.mechanisms.mounted import slider_crank
 from femmech.output.diagrams import (
     plot_orbit,
-    plot_stability_chart,
+    plot_speed_study,
     plot_time_histories,
     write_history_csv,
     write_sweep_csv,
@@ -176,7 +176,8 @@ def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int = 70
     Steady state (shooting, Richardson-extrapolated; ρ∞ = 1 so that the rigid-attachment
     forces are those of the discrete solution): ram deflection, crank twist, crank-bearing
     and guide forces on the frame, drive torque (the crank's drive row, seed 5.2.2 eq. 2
-    for j = n+1) and the orbit of the crank bearing. Stability
+    for j = n+1), the column-foot bending moment (elastic section force) and the orbit of
+    the crank bearing. Stability
     (:func:`femmech.analysis.stability.speed_study`): growth rate ln(max|μ|)/T over
     120..1500 strokes/min at the nominal damping and over the frame damping ratio, with
     the principal parametric resonances 2 f_k / j of the two lowest branches marked.
@@ -192,6 +193,9 @@ def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int = 70
     torque = drive_forces(second_kind(slider_crank(), {**DAMPED, **GEOMETRY}), r, drive,
                           system)[:, 0]
     bearing = frame_history(system, model, r.q, [("crank", "ux"), ("crank", "uz")])
+    # column element at the foot (end a); local y = global y: My bends the C-frame's plane
+    foot = int(model.mesh.cell_sets["column"]["line"][0])
+    foot_My = beam_section_forces(system, model, r, foot).component("My")[:, 0, 0]
     deg = np.rad2deg(r.phi)
     q_ram, q_t = (r.q[:, system.labels.index(f"press.{c}")] for c in ("q", "q_t"))
     force_curves = dict(zip(forces.labels, forces.forces.T, strict=True))
@@ -199,7 +203,8 @@ def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int = 70
         "ram deflection q (µm)": {"q": 1e6 * q_ram},
         "crank twist q_t (mrad)": {"q_t": 1e3 * q_t},
         "force on frame (kN)": {k: 1e-3 * f for k, f in force_curves.items()},
-        "drive torque (kN m)": {"crank drive row": 1e-3 * torque}},
+        "drive torque (kN m)": {"crank drive row": 1e-3 * torque},
+        "column foot bending\nmoment (kN m)": {"M_y (elastic)": 1e-3 * foot_My}},
         out / "steady_state.png", xlabel="crank angle φ (deg), BDC at 0°",
         title=f"Press at {spm:.0f} strokes/min: periodic steady state")
     plot_orbit(1e6 * bearing[:, 0], 1e6 * bearing[:, 1], out / "crank_bearing_orbit.png",
@@ -207,24 +212,18 @@ def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int = 70
                f"Crank bearing over one stroke at {spm:.0f} strokes/min")
     write_history_csv(r.t, {"phi_deg": deg, "q_ram_m": q_ram, "q_t_rad": q_t,
                             **{f"{k}_N": f for k, f in force_curves.items()},
-                            "drive_torque_Nm": torque}, out / "steady_state.csv")
+                            "drive_torque_Nm": torque, "column_foot_My_Nm": foot_My},
+                      out / "steady_state.csv")
     study = speed_study(base, 2 * np.pi * np.linspace(2.0, 25.0, n_speeds), FRAME_ZETA,
                         ZETA_BAND_HZ, zetas, n_steps=n_steps, orders=range(1, 9))
-    plot_stability_chart(study.line, out / "stability_speed.png", quantity="growth_rate",
-                         title=f"Press: Floquet growth rate, frame ζ = {FRAME_ZETA}",
-                         marks=study.marks, speed_unit="rpm")
-    plot_stability_chart(study.chart, out / "stability_chart.png", quantity="growth_rate",
-                         title="Press: growth rate over speed and frame damping",
-                         marks=study.marks, speed_unit="rpm")
+    plot_speed_study(study, out, "Press")
     print(f"steady state at {spm:.0f} strokes/min: ram deflection {1e6 * np.ptp(q_ram):.1f} µm"
           f" peak to peak, crank-bearing force up to"
           f" {1e-3 * np.abs(forces.forces[:, 0]).max():.1f} kN, drive torque up to"
           f" {1e-3 * np.abs(torque).max():.2f} kN m")
-    print(f"stability: growth rate {study.line.growth_rate.max():.2f} 1/s at most (nominal"
-          f" damping); {int((~study.chart.stable).sum())} of {study.chart.stable.size}"
-          " (speed, ζ) points unstable")
+    print(f"stability: {study.summary()}")
     return {"steady_state": r, "forces": forces, "torque": torque, "bearing": bearing,
-            "study": study, "system": system}
+            "study": study, "system": system, "column_foot_My": foot_My}
 
 
 def main(out_dir="out/press", n_angles: int = 181, n_modes: int = 8,

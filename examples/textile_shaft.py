@@ -61,7 +61,7 @@ from femmech.mechanisms import (
 from femmech.output.diagrams import (
     plot_mac,
     plot_orbit,
-    plot_stability_chart,
+    plot_speed_study,
     plot_time_histories,
     write_history_csv,
     write_sweep_csv,
@@ -207,19 +207,12 @@ def dynamics(out_dir="out/textile", n_cams: int = 10, rpm: float = OPERATING_RPM
     study = speed_study(base, 2 * np.pi / 60.0 * np.linspace(300.0, 1800.0, n_speeds),
                         FRAME_ZETA, ZETA_BAND_HZ, zetas, n_steps=n_steps,
                         orders=range(1, 13))
-    plot_stability_chart(study.line, out / "stability_speed.png", quantity="growth_rate",
-                         title=f"{n_cams} cams: growth rate, frame ζ = {FRAME_ZETA}",
-                         marks=study.marks, speed_unit="rpm")
-    plot_stability_chart(study.chart, out / "stability_chart.png", quantity="growth_rate",
-                         title=f"{n_cams} cams: growth rate over speed and frame damping",
-                         marks=study.marks, speed_unit="rpm")
+    plot_speed_study(study, out, f"{n_cams} cams")
     print(f"steady state at {rpm:.0f} rpm: follower deflection up to"
           f" {1e6 * max(np.abs(v).max() for v in q2.values()):.1f} µm, motor torque"
           f" {motor.min():.1f} .. {motor.max():.1f} N m (cam drive rows"
           f" {rows.min():.1f} .. {rows.max():.1f} N m)")
-    print(f"stability: growth rate {study.line.growth_rate.max():.3f} 1/s at most (nominal"
-          f" damping); {int((~study.chart.stable).sum())} of {study.chart.stable.size}"
-          " (speed, ζ) points unstable")
+    print(f"stability: {study.summary()}")
     return {"steady_state": r, "forces": forces, "motor_torque": motor, "drive_rows": rows,
             "study": study, "system": system}
 

@@ -67,6 +67,12 @@ class BeamProperty:
     rotary_inertia: bool = True
 
 
+# columns of BeamSet.properties: the arguments of elements.beam.local_matrices (after the
+# length) and the rotary inertia flag
+BEAM_PROPERTY_COLUMNS = ("E", "G", "rho", "A", "Iy", "Iz", "J", "Ip", "Asy", "Asz",
+                         "rotary_inertia")
+
+
 @dataclass(frozen=True)
 class BeamSet:
     """Beam elements of a model, for recovery and drawing.
@@ -83,6 +89,11 @@ class BeamSet:
     phi : ndarray (n_elements, 2)
         Shear parameters ``Φ = 12 E I / (G A_s L²)`` of the local x-y plane (Iz, Asy) and
         x-z plane (Iy, Asz); 0 for Euler-Bernoulli bending.
+    properties : ndarray (n_elements, 11)
+        Element data in the order of :data:`BEAM_PROPERTY_COLUMNS` (E, G in Pa, ρ in
+        kg/m³, A, A_s in m², I, J, I_p in m⁴, rotary inertia flag 0/1), so that element
+        matrices can be rebuilt (:func:`femmech.elements.beam.local_matrices`) for
+        force recovery.
     """
 
     cells: np.ndarray
@@ -91,6 +102,7 @@ class BeamSet:
     radius: np.ndarray
     group: np.ndarray
     phi: np.ndarray
+    properties: np.ndarray = field(default_factory=lambda: np.zeros((0, 11)))
 
 
 @dataclass(frozen=True)
@@ -338,7 +350,8 @@ def _beam_blocks(mesh: Mesh, beams: dict[str, BeamProperty], with_shells: bool =
     group = np.array(names, dtype=object)[owner] if len(lines) else np.empty(0, dtype=object)
     phi = 12.0 * E[:, None] * np.column_stack([Iz, Iy]) / (
         G[:, None] * np.column_stack([Asy, Asz]) * length[:, None] ** 2)
-    return BeamSet(lines, R, length, radius, group, phi), Ke, Me, element_dofs(lines)
+    return (BeamSet(lines, R, length, radius, group, phi, rows[:, :11]), Ke, Me,
+            element_dofs(lines))
 
 
 def _property_row(p: BeamProperty) -> list[float]:

@@ -215,7 +215,7 @@ def test_drive_end_torque_is_the_cams_torque_at_low_speed(processing):
     # At 30 rpm the cams' harmonics that matter lie far below the shaft's torsion modes
     # (~90 Hz), so the shaft transmits the cam torques quasi-statically: the reaction
     # at the kinematic drive end equals the sum of the cams' drive rows (seed 5.2.2 eq.
-    # 2, j = n+1) up to the shaft's own inertia torque. Measured 1.6e-4 of the peak.
+    # 2, j = n+1) up to the shaft's own inertia torque. Measured 6.8e-5 of the peak.
     pm, system, model, rayleigh = processing
     W = 2 * np.pi * 30 / 60
     r = periodic_steady_state(system, W, n_steps=720, rho_inf=1.0)
@@ -223,7 +223,7 @@ def test_drive_end_torque_is_the_cams_torque_at_low_speed(processing):
     motor = support_reactions(system, model, r, [("drive_end", "rx")], *rayleigh)[:, 0]
     rows = sum(drive_forces(lg, r, drive, system, mount=k)[:, 0]
                for k, lg in enumerate(pm.cam_models(second_kind)))
-    assert np.abs(motor - rows).max() < 2e-3 * np.abs(rows).max()
+    assert np.abs(motor - rows).max() < 5e-4 * np.abs(rows).max()
     with pytest.raises(ValueError, match="is not supported"):
         support_reactions(system, model, r, [("drive_end", "uy")])
 
@@ -236,7 +236,7 @@ def test_press_dynamics(tmp_path):
     # ch. 2), so the output elasticity carries q = m2 r Ω² (1 + r/l) / c2 and the crank
     # bearing the force m2 r Ω² (1 + r/l) (the crank's mass is neglected). At 600
     # strokes/min the first frame mode (60 Hz) and the ram mode lie far above the
-    # speed's harmonics that matter; measured deviations 0.3 % and 0.2 %.
+    # speed's harmonics that matter; measured deviations 0.25 % for both.
     press = _load("press_frame")
     result = press.dynamics(tmp_path, n_speeds=3, zetas=(0.005, 0.02))
     p, g = press.PARAMS, press.GEOMETRY
@@ -247,7 +247,8 @@ def test_press_dynamics(tmp_path):
     assert q_ram == pytest.approx(inertia / p["c2"], rel=1e-2)
     assert forces.forces[0, 0] == pytest.approx(inertia, rel=1e-2)
     # at both dead centres the rod lies on the slider axis: no lateral guide force
-    # beyond the frame's vibration (measured 1.3e-3 of the bearing force)
+    # beyond the ram's lateral inertia on the vibrating gib (measured 3.6e-3 at BDC and
+    # 4.2e-4 at TDC of the bearing force at BDC)
     for k in (0, 360):
         assert abs(forces.forces[k, 2]) < 5e-3 * abs(forces.forces[0, 0])
     study = result["study"]

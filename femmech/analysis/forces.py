@@ -1,6 +1,6 @@
-"""Force recovery from time histories: attachment (bearing) forces and drive forces.
+"""Force recovery from time histories: attachment (bearing), drive, support and section forces.
 
-Sign convention (both functions): a force is the generalized force in the positive
+Sign convention (first three functions): a force is the generalized force in the positive
 direction of the coordinate it belongs to.
 
 * :func:`attachment_forces` returns the force the **mechanism exerts on the frame**
@@ -16,6 +16,10 @@ direction of the coordinate it belongs to.
   cylinder force): the drive row of the nonlinear 2nd-kind equations (seed 5.2.1 eq. 13)
   ``Q_d = (M q̈ + h(q, q̇) + W_pot,q − Q*)_d`` evaluated on the programmed motion plus
   the vibration coordinates of a response (N m for an angle, N for a length).
+* :func:`support_reactions` returns the force a support exerts on the frame.
+* :func:`beam_section_forces` returns section forces of beam elements in their local
+  axes, with the beam convention stated in :class:`SectionForces` (not the coordinate
+  convention above).
 """
 
 from __future__ import annotations
@@ -27,6 +31,9 @@ import numpy as np
 from femmech.analysis.response import _drive, _node_component, frame_history
 from femmech.coupling import CoupledSystem, frame_row
 from femmech.dofs import COMPONENTS, DOF_PER_NODE
+from femmech.elements.beam import local_matrices
+from femmech.model import FEModel
+from femmech.substructures import Assembly
 
 
 @dataclass(frozen=True)
@@ -230,3 +237,174 @@ def support_reactions(system: CoupledSystem, model, response, dofs, mass_coef: f
                for x in (response.q, response.v, response.a))
     B = mass_coef * M + stiffness_coef * K
     return u @ K.T + v @ B.T + a @ M.T
+
+
+SECTION_COMPONENTS = ("N", "Vy", "Vz", "T", "My", "Mz")
+
+
+@dataclass(frozen=True)
+class SectionForces:
+    """Section forces of beam elements at their two ends, as time histories.
+
+    Attributes
+    ----------
+    elements : ndarray of int (n_el,)
+        Beam element indices (rows of ``model.beams.cells``), in the order requested.
+    forces : ndarray (n_t, n_el, 2, 6)
+        Section forces at end a (``[:, :, 0]``) and end b (``[:, :, 1]``) in the element's
+        local axes, components :data:`SECTION_COMPONENTS` = (N, Vy, Vz, T, My, Mz): N and
+        V in N, T and M in N m. Sign: the force and moment vectors that the part of the
+        member on the +x side of the cut exerts on the part on the −x side (local x from
+        node a to node b). N > 0 is tension; dMz/dx = −Vy and dMy/dx = +Vz between loads.
+    dynamic : bool
+        True if the inertia and damping forces of the elements are included.
+    """
+
+    elements: np.ndarray
+    forces: np.ndarray
+    dynamic: bool
+
+    def component(self, name: str) -> np.ndarray:
+        """One component, ndarray (n_t, n_el, 2) (ends a and b), N or N m."""
+        if name not in SECTION_COMPONENTS:
+            raise ValueError(f"unknown section force component {name!r}; use one of"
+                             f" {SECTION_COMPONENTS}")
+        return self.forces[..., SECTION_COMPONENTS.index(name)]
+
+
+def _beam_elements(model, elements) -> np.ndarray:
+    """Beam element indices from an index, a cell group name or a sequence of both."""
+    n_beams = len(model.beams.cells)
+    if n_beams == 0:
+        raise ValueError("the model has no beam elements: section forces need beams")
+    items = [elements] if isinstance(elements, (str, int, np.integer)) else list(elements)
+    if not items:
+        raise ValueError("no beam elements requested: give element indices or group names")
+    out = []
+    for item in items:
+        if isinstance(item, str):
+            if item not in model.mesh.cell_sets:
+                raise ValueError(f"unknown element group {item!r}; the mesh has cell groups"
+                                 f" {sorted(model.mesh.cell_sets)}")
+            idx = model.mesh.cell_sets[item].get("line", np.empty(0, dtype=np.int64))
+            if not len(idx):
+                raise ValueError(f"element group {item!r} has no beam (line) elements")
+            out.append(np.asarray(idx, dtype=np.int64))
+        elif isinstance(item, (int, np.integer)) and not isinstance(item, bool):
+            if not 0 <= item < n_beams:
+                raise ValueError(f"beam element {item} is out of range: the model has"
+                                 f" {n_beams} beam elements (0..{n_beams - 1})")
+            out.append(np.array([item], dtype=np.int64))
+        else:
+            raise TypeError(f"beam element {item!r}: give an element index (int) or a cell"
+                            " group name (str)")
+    return np.concatenate(out)
+
+
+def _check_frame(system: CoupledSystem, model, part):
+    """The frame (or Assembly part) that ``model`` belongs to; raises on a mismatch."""
+    frame = system.frame
+    if isinstance(frame, Assembly):
+        if part is None or not 0 <= part < len(frame.parts):
+            raise ValueError(f"the frame is an Assembly of {len(frame.parts)} parts: give the"
+                             f" part index of the FE model (part=0..{len(frame.parts) - 1})")
+        frame = frame.parts[part]
+    elif part is not None:
+        raise ValueError(f"part={part} is given, but the frame is not an Assembly")
+    n_dof = frame.n_dof if isinstance(frame, FEModel) else frame.T.shape[0]
+    if n_dof != model.n_dof:
+        raise ValueError(f"the model has {model.n_dof} DOFs, the frame {n_dof}: give the FE"
+                         " model the frame was built (or reduced) from")
+
+
+def beam_section_forces(system: CoupledSystem, model, response, elements,
+                        dynamic: bool = False, mass_coef: float = 0.0,
+                        stiffness_coef: float = 0.0, part: int | None = None) -> SectionForces:
+    """Section forces at the ends of beam elements, as time histories.
+
+    The element end forces in local axes are ``f = K_e u_e`` (``dynamic=False``, the
+    default) or ``f = K_e u_e + B_e u̇_e + M_e ü_e`` with ``B_e = a M_e + b K_e``
+    (``dynamic=True``); u_e are the element's 12 local DOFs, recovered from the response
+    through only their rows of the recovery
+    (:func:`~femmech.analysis.response.frame_history`), and K_e, M_e the element's own
+    matrices (:func:`~femmech.elements.beam.local_matrices`). The force the node exerts on
+    the element is f; the section force (see :class:`SectionForces`) is ``−f_a`` at end a
+    and ``+f_b`` at end b.
+
+    Which part. ``K_e u_e`` is the elastic section force: the stress resultant of the
+    element's own displacement field (N = EA ε, M = EI κ of the interpolation, constant
+    N, V, T and linear M along the element), the part that stress and fatigue checks use
+    (σ = N/A ± M c/I). It does not depend on the damping model and is what a
+    mode-displacement recovery gives. ``M_e ü_e`` is the work-equivalent (consistent)
+    nodal load of the element's own distributed inertia, which belongs to the element's
+    mass, not to a cut; ``a M_e u̇_e`` is the mass-proportional Rayleigh force, a
+    damping to ground rather than an internal force. Adding them gives the forces by
+    which the nodes drive the element: these balance exactly at every node against the
+    nodal loads, point-mass inertia and support reactions (use ``dynamic=True`` for such
+    balances, e.g. the load a member passes to a joint), and at the element ends they
+    include the element's share of its own inertia, which the elastic part misses. The
+    two differ by O(element mass × acceleration), which vanishes as the mesh is refined,
+    and are equal in a static state. Hence the default is the elastic part.
+    Parameters
+    ----------
+    system : CoupledSystem
+        With the frame reduced from (or equal to) ``model``.
+    model : FEModel
+        The frame's FE model (its beam elements and DOF numbering).
+    response : Response
+        Time history on ``system`` (``q``; ``v`` and ``a`` with ``dynamic=True``).
+    elements : int, str or sequence of int and str
+        Beam element indices (rows of ``model.beams.cells``) or cell group names of the
+        mesh (all beam elements of the group, in the group's order).
+    dynamic : bool
+        Include the element inertia and damping forces (see above).
+    mass_coef, stiffness_coef : float
+        Rayleigh coefficients a (1/s) and b (s) of the frame damping of the response, as
+        in :func:`~femmech.analysis.response.rayleigh_damping`; with ``dynamic=True`` only.
+    part : int, optional
+        For an :class:`~femmech.substructures.Assembly` frame: the part ``model`` is.
+
+    Returns
+    -------
+    SectionForces
+        ``forces`` (n_t, n_el, 2, 6), N and N m, in the element's local axes.
+
+    Raises
+    ------
+    ValueError
+        For a model without beams, an unknown group, an element index out of range, a
+        model that does not match the frame, or damping coefficients without
+        ``dynamic=True``.
+    """
+    if not dynamic and (mass_coef or stiffness_coef):
+        raise ValueError("mass_coef and stiffness_coef apply to the dynamic end forces only:"
+                         " give dynamic=True")
+    _check_frame(system, model, part)
+    idx = _beam_elements(model, elements)
+    beams = model.beams
+    cells = beams.cells[idx]
+    dofs = (DOF_PER_NODE * cells[:, :, None] + np.arange(DOF_PER_NODE)).reshape(-1, 12)
+    unique, inverse = np.unique(dofs, return_inverse=True)
+    keys = [int(d) for d in unique] if part is None else [
+        ((part, int(d) // DOF_PER_NODE), COMPONENTS[int(d) % DOF_PER_NODE]) for d in unique]
+    props = beams.properties[idx]
+    if props.shape != (len(idx), 11):
+        raise ValueError("the model's BeamSet has no element properties (build it with"
+                         " femmech.build_model)")
+    K, M = local_matrices(beams.length[idx], *props[:, :10].T, rotary_inertia=props[:, 10])
+    R = beams.frames[idx]
+
+    def local(history):
+        """Element DOFs in local axes, (n_t, n_el, 12)."""
+        u = frame_history(system, model, history, keys)[:, inverse.reshape(dofs.shape)]
+        u = u.reshape(u.shape[0], len(idx), 4, 3)
+        return np.einsum("eij,tekj->teki", R, u).reshape(u.shape[0], len(idx), 12)
+
+    f = np.einsum("eij,tej->tei", K, local(response.q))
+    if dynamic:
+        v, a = local(response.v), local(response.a)
+        f += (np.einsum("eij,tej->tei", M, a + mass_coef * v)
+              + stiffness_coef * np.einsum("eij,tej->tei", K, v))
+    forces = f.reshape(f.shape[0], len(idx), 2, 6)
+    forces[:, :, 0] *= -1.0
+    return SectionForces(idx, forces, bool(dynamic))

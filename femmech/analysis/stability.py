@@ -471,6 +471,8 @@ class SpeedStudy:
         Angle-averaged quasi-eigenfrequencies of the marked branches, Hz.
     basis_size : int
         Columns of the Ritz basis used for the monodromy matrices.
+    zeta : float
+        Nominal frame damping ratio of ``line``.
     """
 
     line: StabilityChart
@@ -478,6 +480,16 @@ class SpeedStudy:
     marks: dict
     mean_freq_hz: np.ndarray
     basis_size: int
+    zeta: float = float("nan")
+
+    def summary(self) -> str:
+        """One line: the largest growth rate at nominal damping and the unstable points."""
+        text = (f"growth rate {self.line.growth_rate.max():.3g} 1/s at most (frame ζ ="
+                f" {self.zeta:g}, {'stable' if self.line.stable.all() else 'UNSTABLE'})")
+        if self.chart is not None:
+            text += (f"; {int((~self.chart.stable).sum())} of {self.chart.stable.size}"
+                     " (speed, ζ) points unstable")
+        return text
 
 
 def speed_study(system: CoupledSystem, speeds, zeta: float, band_hz: tuple[float, float],
@@ -528,4 +540,4 @@ def speed_study(system: CoupledSystem, speeds, zeta: float, band_hz: tuple[float
         chart = stability_chart(lambda W, ratio: damped(ratio), speeds, damping_ratios,
                                 n_steps=n_steps, angle_period=angle_period,
                                 parameter_name="frame damping ratio ζ (-)", basis=basis)
-    return SpeedStudy(line, chart, marks, mean_hz, basis.shape[1])
+    return SpeedStudy(line, chart, marks, mean_hz, basis.shape[1], float(zeta))

@@ -230,3 +230,24 @@ def write_history_csv(t, columns: dict, filename, time_label: str = "t_s") -> Pa
         np.savetxt(tmp, rows, delimiter=",", header=",".join([time_label, *columns]),
                    comments="", fmt="%.10g")
     return Path(filename)
+
+
+def plot_speed_study(study, out_dir, name: str, speed_unit: str = "rpm") -> list[Path]:
+    """The two pictures of a :class:`~femmech.analysis.stability.SpeedStudy` (PNG).
+
+    ``stability_speed.png``: growth rate over speed at the nominal frame damping;
+    ``stability_chart.png`` (with damping ratios): growth rate over speed and frame
+    damping, unstable regions shaded. Both mark the predicted resonance speeds; ``name``
+    starts the titles.
+    """
+    out = Path(out_dir)
+    files = [plot_stability_chart(study.line, out / "stability_speed.png",
+                                  title=f"{name}: growth rate, frame ζ = {study.zeta:g}",
+                                  marks=study.marks, quantity="growth_rate",
+                                  speed_unit=speed_unit)]
+    if study.chart is not None:
+        files.append(plot_stability_chart(
+            study.chart, out / "stability_chart.png", marks=study.marks,
+            title=f"{name}: growth rate over speed and frame damping",
+            quantity="growth_rate", speed_unit=speed_unit))
+    return files
