@@ -71,6 +71,8 @@ MODELS = {
     "medium": ((8, 8, 8), 10, True),       # 109 350 DOFs
     "medium-free": ((8, 8, 8), 10, False),
     "large": ((16, 16, 16), 12, True),     # 945 030 DOFs
+    "20k": ((5, 5, 5), 8, True),           # 23 760 free DOFs (as in benchmarks/solvers.py)
+    "150k": ((9, 9, 9), 10, True),         # 151 200 free DOFs (as in benchmarks/solvers.py)
 }
 # assembly reference (loop) cases: name: (bays, subdivisions, run the loop reference)
 ASSEMBLY = {
@@ -351,9 +353,13 @@ def _property_arrays():
 
 # --- cases ----------------------------------------------------------------------------
 
-def assembly_case(name):
-    """Loop reference against the vectorised assembly, and the full ``build_model``."""
+def assembly_case(name, references=True):
+    """Loop reference against the vectorised assembly, and the full ``build_model``.
+
+    ``references=False`` skips the per-element loop.
+    """
     bays, subdivisions, with_loop = ASSEMBLY[name]
+    with_loop = with_loop and references
     mesh = frame_mesh(bays, subdivisions)
     row = {"table": "assembly", "case": name, "elements": len(mesh.cells["line"]),
            "dofs": 6 * mesh.n_nodes}
@@ -375,13 +381,14 @@ def assembly_case(name):
     return row
 
 
-def modes_case(name, with_slow, history):
+def modes_case(name, with_slow, history, references=True):
     bays, subdivisions, supported = MODELS[name]
     mesh = frame_mesh(bays, subdivisions)
     model, row = build(mesh, supported)
     row.update(table="modes", case=name, supported=supported)
     row.update(solve(model))
-    row["references"] = reference_rows(model, row, with_slow, history)
+    row["references"] = (reference_rows(model, row, with_slow, history) if references
+                         else [])
     for key in ("omega2", "freq_hz"):
         row.pop(key)
     return row
@@ -422,10 +429,12 @@ def format_tables(rows) -> list[str]:
                         f"{r['eigen_peak_mb']:.0f}",
                         ", ".join(f"{f:.3f}" for f in r["f123_hz"]),
                         f"{r['max_residual']:.1e}", _sturm(r)] for r in modal])
-        out += _table("Reference (same process): independent solve of the same K_free, M_free",
-                      ["case", "free DOFs", "reference", "ref s", "femmech s", "speedup",
-                       "max rel freq err"],
-                      [line for r in modal for line in _reference_lines(r)])
+        references = [line for r in modal for line in _reference_lines(r)]
+        if references:
+            out += _table("Reference (same process): independent solve of the same K_free,"
+                          " M_free",
+                          ["case", "free DOFs", "reference", "ref s", "femmech s", "speedup",
+                           "max rel freq err"], references)
     asm = [r for r in rows if r["table"] == "assembly"]
     if asm:
         out += _table("Assembly of K and M: per-element Python loop vs vectorised"
@@ -464,24 +473,36 @@ def _reference_lines(r):
 # --- entry points ---------------------------------------------------------------------
 
 def main(sizes=("small", "medium", "large"), with_slow_reference=False,
-         out_file=Path(__file__).parent / "results" / "frame_modes.txt", echo=True):
+         out_file=Path(__file__).parent / "results" / "frame_modes.txt", echo=True,
+         cases=None, references=True):
     """Run the benchmark for ``sizes`` (keys of SIZE_CASES); return one dict per table row.
 
     Rows carry ``"table"`` (``"modes"`` or ``"assembly"``), ``"case"`` and the timings (s),
     peak memory (MB), frequencies (Hz), residuals and reference errors shown in the tables.
+    ``cases = (modal names, assembly names)`` (keys of MODELS and ASSEMBLY) runs those
+    instead of ``sizes``; ``references=False`` skips the independent reference solves and
+    the per-element loop assembly (benchmarks/run.py's assembly entry).
     """
-    unknown = [s for s in sizes if s not in SIZE_CASES]
-    if unknown:
-        raise ValueError(f"unknown sizes {unknown}; choose from {list(SIZE_CASES)}")
+    if cases is not None:
+        unknown = ([c for c in cases[0] if c not in MODELS]
+                   + [c for c in cases[1] if c not in ASSEMBLY])
+        if unknown:
+            raise ValueError(f"unknown cases {unknown}; choose from {list(MODELS)} and"
+                             f" {list(ASSEMBLY)}")
+        plan = [tuple(cases)]
+    else:
+        unknown = [s for s in sizes if s not in SIZE_CASES]
+        if unknown:
+            raise ValueError(f"unknown sizes {unknown}; choose from {list(SIZE_CASES)}")
+        plan = [SIZE_CASES[size] for size in sizes]
     _return_freed_memory()
     rows, history = [], []
-    for size in sizes:
-        modal, assembly = SIZE_CASES[size]
+    for modal, assembly in plan:
         for name in assembly:
-            rows.append(assembly_case(name))
+            rows.append(assembly_case(name, references))
             gc.collect()
         for name in modal:
-            rows.append(modes_case(name, with_slow_reference, history))
+            rows.append(modes_case(name, with_slow_reference, history, references))
             gc.collect()
             if echo:
                 print(f"... {name} done", file=sys.stderr, flush=True)

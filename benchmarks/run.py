@@ -1,0 +1,322 @@
+"""Benchmark suite: every benchmark of issue 10 from one entry point, one table file each.
+
+Usage::
+
+    python benchmarks/run.py [--size tiny|small|medium|large] [--only NAME ...]
+                             [--out DIR] [--blas-threads N]
+
+Runs the entries below one after the other in this process, prints a table per entry and
+writes it to ``benchmarks/results/<name>.txt`` (atomically). Every table starts with the
+same header: machine (CPU, cores, memory, load average at start and end of the entry),
+library versions (numpy, scipy, scikit-fem, femmech, MKL/PARDISO, scikit-sparse, exudyn)
+and the solver and thread settings (:mod:`femmech.solvers`, :mod:`femmech.threads`).
+
+Entries (each reuses the ``main`` of a benchmark module in this folder):
+
+- ``assembly``: ``build_model`` split into element matrices, COO → CSR, Tᵀ K T, and its
+  ratio to one 20-mode eigensolve of the same frame (frame_modes.py);
+- ``eigensolve``: full 20-mode eigensolve per installed sparse solver (solvers.py);
+- ``craig_bampton``: Craig-Bampton reduction split into factorisation, constraint modes,
+  fixed-interface modes and projection, against a full eigensolve (craig_bampton.py);
+- ``reduced_sweep``: reduced coupled sweep over 360 and 3600 angles, r <= 100
+  (coupled_sweep.py without the full solves);
+- ``coupled``: full coupled vs reduced coupled per angle, with the error (coupled_sweep.py);
+- ``exudyn_hcb``: femmech's Craig-Bampton against Exudyn's Hurty-Craig-Bampton on the same
+  K, M and interface (exudyn_hcb.py; reported as not installed without ``exudyn``).
+
+Sizes: ``tiny`` (smoke test, seconds), ``small`` (~20k-DOF frames, a few minutes),
+``medium`` (20k and 150k-DOF frames), ``large`` (adds the 1M-DOF frame to the assembly
+entry and the solid block to the eigensolve entry).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import importlib.metadata
+import os
+import platform
+import sys
+import time
+import traceback
+from contextlib import nullcontext
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import scipy
+from threadpoolctl import threadpool_limits
+
+import femmech as fm
+from femmech import solvers, threads
+from femmech.output.export import atomic_path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+import coupled_sweep  # noqa: E402  (sibling benchmarks)
+import craig_bampton  # noqa: E402
+import exudyn_hcb  # noqa: E402
+import frame_modes  # noqa: E402
+import solvers as solver_bench  # noqa: E402
+
+RESULTS = HERE / "results"
+SIZES = ("tiny", "small", "medium", "large")
+ASSEMBLY_TARGET = 0.2  # issue 10: assembly <= 20 % of one full eigensolve
+SWEEP_TARGET_S = 0.5  # issue 10: 360 angles with vectors, r <= 100, <= 0.5 s
+
+
+# --- header ---------------------------------------------------------------------------
+
+def _version(dist: str) -> str:
+    try:
+        return importlib.metadata.version(dist)
+    except importlib.metadata.PackageNotFoundError:
+        return "not installed"
+
+
+def _cpu() -> tuple[str, int]:
+    """(CPU model name, physical cores) from /proc/cpuinfo (platform fallbacks)."""
+    name, cores = platform.processor() or platform.machine(), set()
+    try:
+        with open("/proc/cpuinfo") as fh:
+            block = {}
+            for line in list(fh) + [""]:
+                if not line.strip():
+                    if "core id" in block:
+                        cores.add((block.get("physical id"), block["core id"]))
+                    block = {}
+                    continue
+                key, _, value = line.partition(":")
+                block[key.strip()] = value.strip()
+                if key.strip() == "model name":
+                    name = value.strip()
+    except OSError:
+        pass
+    return name, len(cores) or os.cpu_count() or 1
+
+
+def header(name: str, size: str, load_start, blas_threads) -> list[str]:
+    """Machine, versions, solver and thread settings, for the top of every table."""
+    cpu, cores = _cpu()
+    mem_gib = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30
+    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else "?"
+    loads = [", ".join(f"{x:.1f}" for x in v) for v in (load_start, os.getloadavg())]
+    pardiso = solvers.mkl_version() if "pardiso" in solvers.available() else None
+    exudyn = exudyn_hcb.exudyn_version()
+    env = ", ".join(f"{k}={os.environ[k]}" for k in (
+        "FEMMECH_THREADS", "FEMMECH_SOLVER", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+        "MKL_NUM_THREADS") if k in os.environ) or "no thread/solver variables set"
+    auto_large = solvers.resolve("auto", solvers.AUTO_MIN_SIZE)
+    return [
+        f"benchmark: {name} (suite size {size}), {datetime.datetime.now():%Y-%m-%d %H:%M}",
+        f"machine: {cpu}, {cores} cores / {os.cpu_count()} CPUs ({usable} usable),"
+        f" {mem_gib:.0f} GiB RAM, {platform.system()} {platform.release()}",
+        f"load average (1, 5, 15 min): at start {loads[0]}; at end {loads[1]}"
+        " (a shared machine: times scale with the load, ratios are from one process)",
+        f"versions: python {platform.python_version()}, numpy {np.__version__}, scipy"
+        f" {scipy.__version__}, scikit-fem {_version('scikit-fem')}, femmech"
+        f" {getattr(fm, '__version__', _version('femmech'))}, mkl {_version('mkl')}"
+        f" (PARDISO {'available' if pardiso else 'not available'}), scikit-sparse"
+        f" {_version('scikit-sparse')}, exudyn {exudyn or 'not installed'}",
+        f"solvers: installed {', '.join(solvers.available())}; default"
+        f" '{solvers.default_solver()}' ('auto' takes {auto_large} from"
+        f" {solvers.AUTO_MIN_SIZE:,} unknowns, SuperLU below); "
+        + "; ".join(f"{k}: {v}" for k, v in solvers.versions().items()),
+        threads.describe(),
+        f"suite BLAS limit: {blas_threads or 'none (--blas-threads)'}; environment: {env}",
+        ""]
+
+
+# --- entries --------------------------------------------------------------------------
+
+def _fmt(value, spec, missing="-"):
+    return missing if value is None else format(value, spec)
+
+
+def entry_assembly(size):
+    cases = {"tiny": (["tiny"], ["tiny"]), "small": (["20k"], []),
+             "medium": (["20k", "150k"], []),
+             "large": (["150k", "large"], ["100k-elements"])}[size]
+    rows = frame_modes.main(cases=cases, references=False, out_file=None, echo=False)
+    modal = [r for r in rows if r["table"] == "modes"]
+    for r in modal:
+        r["build_over_eigen"] = r["build_s"] / r["eigen_s"]
+    lines = frame_modes.format_tables(rows)
+    lines += frame_modes._table(
+        f"Assembly vs one full eigensolve (target: build_model <= {ASSEMBLY_TARGET:.0%} of"
+        " femmech.modes(20))",
+        ["case", "free DOFs", "build_model s", "eigen s", "build / eigen"],
+        [[r["case"], f"{r['free_dofs']:,}", f"{r['build_s']:.3f}", f"{r['eigen_s']:.3f}",
+          f"{r['build_over_eigen']:.2f}"] for r in modal])
+    return lines, rows
+
+
+def entry_eigensolve(size):
+    sizes = {"tiny": ("tiny",), "small": ("20k",), "medium": ("20k", "150k"),
+             "large": ("20k", "150k", "solid")}[size]
+    rows = solver_bench.main(sizes=sizes, out_file=None, echo=False)
+    return solver_bench.format_tables(rows), rows
+
+
+def _frames(size):
+    return {"tiny": ("tiny",), "small": ("20k",)}.get(size, ("20k", "150k"))
+
+
+def entry_craig_bampton(size):
+    rows = craig_bampton.main(sizes=_frames(size), out_file=None, echo=False)
+    return craig_bampton.format_tables(rows), rows
+
+
+def entry_reduced_sweep(size):
+    n_cams, angles = (4, (36, 360)) if size == "tiny" else (12, (360, 3600))
+    rows = []
+    for n_angles in angles:
+        for vectors in (True, False):
+            row = coupled_sweep.main(n_cams=n_cams, n_angles=n_angles, n_check=0,
+                                     keep_vectors=vectors)
+            rows.append(row)
+    lines = [[str(r["n_cams"]), str(r["n_reduced"]), f"{r['n_angles']:,}",
+              "yes" if r["keep_vectors"] else "no", str(r["n_modes"]), f"{r['sweep_s']:.3f}",
+              f"{r['sweep_per_angle_ms']:.3f}"] for r in rows]
+    table = frame_modes._table(
+        "Reduced coupled sweep (textile shaft with N cams, Craig-Bampton + residual vectors,"
+        " mode tracking, BLAS 1 thread)",
+        ["cams N", "coordinates r", "angles", "vectors", "modes", "sweep s", "ms/angle"], lines)
+    return table + [f"target (issue 10): 360 angles with vectors, r <= 100, <= {SWEEP_TARGET_S}"
+                    " s", ""], rows
+
+
+def entry_coupled(size):
+    # (cams, FE elements between cams, checked angles): FE free DOFs ~ 12 (N + 1) P
+    plans = {"tiny": [(4, 2, 2)], "small": [(12, 128, 4)],
+             "medium": [(12, 128, 4), (12, 960, 4)], "large": [(12, 128, 4), (12, 960, 4)]}
+    n_angles = 36 if size == "tiny" else 360
+    rows = [coupled_sweep.main(n_cams=n, n_angles=n_angles, n_check=k, per_spacing=p,
+                               keep_vectors=True)
+            for n, p, k in plans[size]]
+    lines = []
+    for r in rows:
+        per = r["per_angle"]
+        for a, phi in enumerate(per["phi"]):
+            full_ms = 1e3 * per["full_s"][a]
+            lines.append([f"{r['fe_free_dofs']:,}", str(r["n_full"]), str(r["n_reduced"]),
+                          f"{np.rad2deg(phi):.1f}", f"{full_ms:.1f}",
+                          f"{r['sweep_per_angle_ms']:.3f}",
+                          f"{full_ms / r['sweep_per_angle_ms']:.0f}x",
+                          f"{per['max_rel_error'][a]:.1e}", f"{per['min_mac'][a]:.8f}"])
+    table = frame_modes._table(
+        "Full coupled (sparse shift-invert ARPACK + Sturm) vs reduced coupled (sweep, per"
+        " angle), textile shaft with 12 cams (4 on tiny)",
+        ["FE free DOFs", "full n", "reduced r", "angle deg", "full ms", "reduced ms/angle",
+         "speedup", "max |df|/f", "min MAC"], lines)
+    notes = [f"reduced ms/angle: the tracked sweep over {n_angles} angles with vectors,"
+             " divided by the angles; errors over the 6 lowest modes; issue 10 target:"
+             " >= 10 000x at ~150k DOFs with <= 1e-3 error.",
+             *(f"FE {r['fe_free_dofs']:,} free DOFs: build {r['build_s']:.2f} s (reduction"
+               f" {r['reduction_s']:.2f} s), mean full {r['full_per_angle_ms']:.1f} ms,"
+               f" speedup {r['speedup']:.0f}x, max error {r['max_rel_error']:.1e}"
+               for r in rows), ""]
+    for r in rows:  # arrays -> lists, for the caller's checks
+        r["per_angle"] = {k: np.asarray(v).tolist() for k, v in r["per_angle"].items()}
+    return table + notes, rows
+
+
+def entry_exudyn_hcb(size):
+    if exudyn_hcb.exudyn_version() is None:
+        return exudyn_hcb.not_installed_lines(), []
+    rows = exudyn_hcb.main(sizes=_frames(size), out_file=None, echo=False)
+    lines = exudyn_hcb.format_tables(rows)
+    for case in dict.fromkeys(r["case"] for r in rows):
+        pair = [r for r in rows if r["case"] == case]
+        best = min(r["exudyn_s"] for r in pair) / min(r["femmech_s"] for r in pair)
+        lines.append(f"{case}: best Exudyn time / best femmech time (over the thread"
+                     f" settings) = {best:.1f}x (issue 10 target: >= 2x at ~20k, >= 5x at"
+                     " ~150k DOFs)")
+    return lines + [""], rows
+
+
+ENTRIES = {
+    "assembly": entry_assembly,
+    "eigensolve": entry_eigensolve,
+    "craig_bampton": entry_craig_bampton,
+    "reduced_sweep": entry_reduced_sweep,
+    "coupled": entry_coupled,
+    "exudyn_hcb": entry_exudyn_hcb,
+}
+
+
+# --- runner ---------------------------------------------------------------------------
+
+@dataclass
+class Result:
+    """One entry's table text, its rows (dicts of numbers), wall time (s) and error."""
+
+    name: str
+    text: str
+    rows: list = field(default_factory=list)
+    seconds: float = 0.0
+    error: str | None = None
+
+
+def run_entry(name: str, size: str, blas_threads: int | None = None) -> Result:
+    """Run one entry; an exception is caught and reported in the table (``error``)."""
+    load_start = os.getloadavg()
+    start = time.perf_counter()
+    rows, error = [], None
+    limit = threadpool_limits(blas_threads) if blas_threads else nullcontext()
+    try:
+        with limit:
+            lines, rows = ENTRIES[name](size)
+    except Exception as exc:  # noqa: BLE001  (the suite goes on; the table says why)
+        error = f"{type(exc).__name__}: {exc}"
+        lines = [f"FAILED: {error}", "", *traceback.format_exc().splitlines()]
+    seconds = time.perf_counter() - start
+    text = "\n".join(header(name, size, load_start, blas_threads) + lines
+                     + [f"entry wall time: {seconds:.1f} s"])
+    return Result(name, text, rows, seconds, error)
+
+
+def main(size: str = "small", only=None, out_dir=RESULTS, echo=True,
+         blas_threads: int | None = None) -> dict[str, Result]:
+    """Run the suite (``only``: subset of ENTRIES) at ``size``; write one file per entry."""
+    if size not in SIZES:
+        raise ValueError(f"unknown size {size!r}; choose from {list(SIZES)}")
+    names = list(ENTRIES) if not only else list(only)
+    unknown = [n for n in names if n not in ENTRIES]
+    if unknown:
+        raise ValueError(f"unknown benchmarks {unknown}; choose from {list(ENTRIES)}")
+    frame_modes._return_freed_memory()
+    if out_dir is not None:
+        Path(out_dir).mkdir(parents=True, exist_ok=True)
+    results = {}
+    for name in names:
+        if echo:
+            print(f"... {name} ({size})", file=sys.stderr, flush=True)
+        result = run_entry(name, size, blas_threads)
+        results[name] = result
+        if echo:
+            print(result.text + "\n", flush=True)
+        if out_dir is not None:
+            with atomic_path(Path(out_dir) / f"{name}.txt") as tmp:
+                tmp.write_text(result.text + "\n")
+    return results
+
+
+def _cli(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--size", choices=SIZES, default="small")
+    parser.add_argument("--only", nargs="+", metavar="NAME", choices=list(ENTRIES),
+                        help=f"run only these entries ({', '.join(ENTRIES)})")
+    parser.add_argument("--out", type=Path, default=RESULTS, help="folder of the table files")
+    parser.add_argument("--blas-threads", type=int, default=None,
+                        help="limit every BLAS/OpenMP library to N threads for the whole run")
+    args = parser.parse_args(argv)
+    results = main(args.size, args.only, args.out, blas_threads=args.blas_threads)
+    failed = [name for name, r in results.items() if r.error]
+    if failed:
+        print(f"failed: {', '.join(failed)}", file=sys.stderr)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(_cli())
