@@ -415,10 +415,12 @@ def _residual_vectors(Kii, Mii, Mib, Psi, Phi, lu):
     gram = R.T @ MR
     w, V = np.linalg.eigh(0.5 * (gram + gram.T))
     keep = w > 1e-10
-    T = V[:, keep] / np.sqrt(w[keep])  # span(R) M-orthonormal: R T
-    stiff = T.T @ (R.T @ (Kii @ R)) @ T
+    R = R @ (V[:, keep] / np.sqrt(w[keep]))  # M-orthonormal basis of the kept directions
+    stiff = R.T @ (Kii @ R)
     omega2, Z = np.linalg.eigh(0.5 * (stiff + stiff.T))
-    return omega2, R @ (T @ Z)  # three n_i x n_b x n_b products in all
+    # one n_i x n_b x n_b product (the Gram matrix); the others have the kept columns only
+    # (an interface of 1 002 DOFs along rails kept 108)
+    return omega2, R @ Z
 
 
 def _project(Kbb, Kib, Mii, Mib, Mbb, Psi, Phi, omega2):
