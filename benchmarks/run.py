@@ -22,11 +22,16 @@ Entries (each reuses the ``main`` of a benchmark module in this folder):
   (coupled_sweep.py without the full solves);
 - ``coupled``: full coupled vs reduced coupled per angle, with the error (coupled_sweep.py);
 - ``exudyn_hcb``: femmech's Craig-Bampton against Exudyn's Hurty-Craig-Bampton on the same
-  K, M and interface (exudyn_hcb.py; reported as not installed without ``exudyn``).
+  K, M and interface (exudyn_hcb.py; reported as not installed without ``exudyn``);
+- ``scale``: the shell/beam machine bed built, Craig-Bampton reduced, coupled with four
+  cams and swept over 360 angles, with time and peak memory per phase and one full coupled
+  check (scale.py: 1 788 / 61 320 / 242 952 / 969 720 DOFs for tiny / small / medium /
+  large).
 
 Sizes: ``tiny`` (smoke test, seconds), ``small`` (~20k-DOF frames, a few minutes),
-``medium`` (20k and 150k-DOF frames), ``large`` (adds the 1M-DOF frame to the assembly
-entry and the solid block to the eigensolve entry).
+``medium`` (20k and 150k-DOF frames, the 61k-DOF shell bed in the eigensolve entry),
+``large`` (adds the 1M-DOF frame to the assembly entry, the solid block to the eigensolve
+entry and the 1M-DOF machine bed to the scale entry).
 """
 
 from __future__ import annotations
@@ -72,6 +77,7 @@ solver_bench = _sibling("solvers")
 craig_bampton = _sibling("craig_bampton")
 exudyn_hcb = _sibling("exudyn_hcb")
 coupled_sweep = _sibling("coupled_sweep")
+scale = _sibling("scale")
 
 RESULTS = HERE / "results"
 SIZES = ("tiny", "small", "medium", "large")
@@ -257,6 +263,11 @@ def entry_exudyn_hcb(size):
     return lines + [""], rows
 
 
+def entry_scale(size):
+    row = scale.main(size, n_check=1, out_file=None, echo=False)
+    return scale.format_report(row, header=False) + [""], [row]
+
+
 ENTRIES = {
     "assembly": entry_assembly,
     "eigensolve": entry_eigensolve,
@@ -264,6 +275,7 @@ ENTRIES = {
     "reduced_sweep": entry_reduced_sweep,
     "coupled": entry_coupled,
     "exudyn_hcb": entry_exudyn_hcb,
+    "scale": entry_scale,
 }
 
 

@@ -243,12 +243,13 @@ def run(size: str = "large", n_angles: int = N_ANGLES, n_check: int = 0,
     return row
 
 
-def format_report(row: dict) -> list[str]:
-    """Plain-text tables of one run, with machine, versions, solver and threads."""
+def format_report(row: dict, header: bool = True) -> list[str]:
+    """Plain-text tables of one run, headed (``header``) by machine, versions and threads."""
     lines = fmb.machine_info() + [threads.describe(),
                                   "solvers: " + "; ".join(f"{k}: {v}" for k, v
-                                                          in solvers.versions().items()),
-                                  f"sparse solver of K_ii: {row['solver']}", ""]
+                                                          in solvers.versions().items())] \
+        if header else []
+    lines += [f"sparse solver of K_ii: {row['solver']}", ""]
     lines.append(f"Machine bed {LENGTH} x {WIDTH} x {HEIGHT} m, {THICKNESS * 1e3:g} mm plates"
                  f" (n = {row['n']} quads per {CELL} m): {row['quads']:,} quads,"
                  f" {row['beams']:,} beams, {row['dofs']:,} DOFs, {row['free_dofs']:,} free;"
