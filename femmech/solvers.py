@@ -333,17 +333,15 @@ one solve of a 20 000-unknown tridiagonal system took 16 ms, with 1 it took 1.1 
 (MKL 2026.2, 2 threads, this 2-core machine under load); block solves of 200 right-hand
 sides on a 24k-DOF frame took the same time with 0, 1 and 2."""
 
-PARDISO_LOOP_COLUMNS = 32
-"""Blocks of up to this many right-hand sides are solved one column at a time when the
-factor is sparse (fewer than :data:`PARDISO_LOOP_FILL` nonzeros per row): there PARDISO's
-multi-right-hand-side solve has a large fixed cost. 151k-DOF beam frame (factor 2.4M
-nonzeros, 16 per row; one thread): 2 columns took 39 ms against 2 x 5.4 ms one at a time,
-16 columns 111 ms against 77 ms, 32 columns 185 against 155 ms. On shells the block
-solve wins: 59k-DOF shell frame (9.4M nonzeros, 161 per row) 2 columns 25 ms against
-27 ms, 8 columns 53 ms against 106 ms, 28 columns 0.13 s against 0.39 s."""
-
 PARDISO_LOOP_FILL = 50
-"""Factor nonzeros per row below which :data:`PARDISO_LOOP_COLUMNS` applies."""
+"""Factor nonzeros per row below which blocks of right-hand sides are solved one column
+at a time: for such sparse factors (beam frames) PARDISO's multi-right-hand-side solve is
+slower than a loop. 151k-DOF beam frame (factor 2.4M nonzeros, 16 per row; one thread):
+2 columns took 39 ms against 2 x 5.4 ms one at a time, 16 columns 111 ms against 77 ms,
+32 columns 185 against 155 ms, the 1 002 constraint modes of a rails interface 13.7 s
+against 7.4 s. On shells the block solve wins: 59k-DOF shell frame (9.4M nonzeros, 161
+per row) 2 columns 25 ms against 27 ms, 8 columns 53 ms against 106 ms, 28 columns
+0.13 s against 0.39 s."""
 
 PARDISO_PERTURBATION = 13
 """iparm(10): pivots below 1e-13 ‖A‖ are perturbed (round-off level). A factorisation
@@ -532,8 +530,7 @@ class PardisoFactor(Factor):
         self._definite = self.mtype == 2 or self.iparm[22] == 0
 
     def _solve(self, b):
-        if b.ndim == 2 and b.shape[1] <= PARDISO_LOOP_COLUMNS \
-                and self.iparm[17] < PARDISO_LOOP_FILL * self.n:
+        if b.ndim == 2 and self.iparm[17] < PARDISO_LOOP_FILL * self.n:
             b = np.asfortranarray(b)  # contiguous columns, solved in place one by one
             x = np.empty_like(b, order="F")
             for j in range(b.shape[1]):
