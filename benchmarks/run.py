@@ -207,7 +207,7 @@ def entry_reduced_sweep(size):
               f"{r['sweep_per_angle_ms']:.3f}"] for r in rows]
     table = frame_modes._table(
         "Reduced coupled sweep (textile shaft with N cams, Craig-Bampton + residual vectors,"
-        " N + 2 modes tracked, BLAS 1 thread)",
+        f" N + 2 modes tracked, solve-phase BLAS threads {threads.settings().solve or 'all'})",
         ["cams N", "coordinates r", "angles", "vectors", "modes", "sweep s", "ms/angle"], lines)
     return table + [f"target (issue 10): 360 angles with vectors, r <= 100, <= {SWEEP_TARGET_S}"
                     " s", ""], rows

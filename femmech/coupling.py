@@ -135,20 +135,29 @@ class CoupledSystem:
     def mechanism_blocks(self, phi, Omega: float = 0.0, Omega_dot: float = 0.0):
         """Per mount: M_m, B_m, C_m (n_angles, t, t) and F_m (n_angles, t) on ``touched``.
 
-        ``phi`` (n_angles,) main drive angles, rad; ``Omega`` main drive speed, rad/s.
-        Mechanism matrices are evaluated for all angles in one call per mount.
+        ``phi`` (n_angles,) main drive angles, rad; ``Omega`` main drive speed, rad/s;
+        ``Omega_dot`` main drive acceleration, rad/s². Mechanism matrices are evaluated
+        for all angles in one call per model and transmission ratio: mounts sharing a
+        model (identical mechanisms on one shaft) are evaluated together, once per
+        distinct phase.
         """
         phi = np.atleast_1d(np.asarray(phi, dtype=float))
-        out = []
-        for mount, P in zip(self.mounts, self.projections, strict=True):
-            angle = mount.ratio * phi + mount.phase
-            speed, accel = mount.ratio * Omega, mount.ratio * Omega_dot
-            m = mount.model
-            Mm, Bm = m.M(angle), m.B(angle, speed)
-            Cm, Fm = m.C(angle, speed, accel), m.F(angle, speed, accel)
-            out.append((_project(P, Mm), _project(P, Bm), _project(P, Cm),
-                        np.einsum("ki,ak->ai", P, Fm)))
-        return out
+        shared = {}
+        for k, mount in enumerate(self.mounts):
+            shared.setdefault((id(mount.model), mount.ratio), []).append(k)
+        own = [None] * len(self.mounts)
+        for ks in shared.values():
+            m, ratio = self.mounts[ks[0]].model, self.mounts[ks[0]].ratio
+            phases, which = np.unique([self.mounts[k].phase for k in ks], return_inverse=True)
+            angle = ratio * phi + phases[:, None]  # (n_phases, n_angles)
+            speed, accel = ratio * Omega, ratio * Omega_dot
+            values = (m.M(angle), m.B(angle, speed), m.C(angle, speed, accel),
+                      m.F(angle, speed, accel))
+            for k, i in zip(ks, which, strict=True):
+                own[k] = [A[i] for A in values]
+        return [(_project(P, Mm), _project(P, Bm), _project(P, Cm),
+                 np.einsum("ki,ak->ai", P, Fm))
+                for P, (Mm, Bm, Cm, Fm) in zip(self.projections, own, strict=True)]
 
     def matrices(self, phi: float, Omega: float = 0.0, Omega_dot: float = 0.0):
         """Coupled M, B, C (n, n) and F (n,) at one drive angle (dense or sparse)."""

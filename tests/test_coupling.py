@@ -318,3 +318,120 @@ def test_assembly_frame_equals_single_superelement(cam_model):
 
 def fe_property():
     return fm.BeamProperty(sections.rectangular_hollow(0.06, 0.08, 0.004), STEEL)
+
+
+def test_batched_angle_matrices_equal_per_angle_assembly(cam_model):
+    # The sweep evaluates the mechanisms once for all angles, grouped by model and ratio
+    # (here one model at two phases and two ratios), and adds the blocks per angle at
+    # precomputed entries; mounts "a" and "c" share the frame coordinate of node 20.
+    from femmech.analysis.sweep import _angle_matrices
+    from femmech.coupling import assemble_at
+
+    se = craig_bampton(_beam(), "mid", n_modes=6)
+    system = couple(se, [
+        Mount(cam_model, (Attachment("y_g", 20, "uy"),), name="a"),
+        Mount(cam_model, (Attachment("y_g", 20, "uy", stiffness=1e8, damping=50.0),),
+              phase=0.7, name="b"),
+        Mount(cam_model, (Attachment("y_g", 20, "uy"),), ratio=2.0, phase=0.7, name="c")])
+    assert np.intersect1d(system.touched[0], system.touched[2]).size == 1
+    phi, Omega, Omega_dot = PHI[:20], 30.0, 5.0
+    blocks = system.mechanism_blocks(phi, Omega, Omega_dot)
+    for mount, P, got in zip(system.mounts, system.projections, blocks, strict=True):
+        m, r = mount.model, mount.ratio
+        angle = r * phi + mount.phase
+        own = (m.M(angle), m.B(angle, r * Omega), m.C(angle, r * Omega, r * Omega_dot))
+        for A, B in zip(got, own, strict=False):  # got also holds F
+            assert_allclose(A, np.einsum("ki,akl,lj->aij", P, B, P), rtol=1e-13, atol=0)
+        assert_allclose(got[3], m.F(angle, r * Omega, r * Omega_dot) @ P, rtol=1e-13)
+    for damped in (True, False):
+        matrices = _angle_matrices(system, phi, Omega, Omega_dot, damped)
+        for a in range(phi.size):
+            expected = assemble_at(system, blocks, a)[:3]
+            for A, B in zip(matrices(a), expected, strict=True):
+                if A is None:
+                    assert not damped
+                    continue
+                assert np.abs(A - B).max() <= 1e-13 * np.abs(B).max()
+
+
+@pytest.mark.parametrize("n_modes", [3, 8])
+def test_dense_symmetric_drivers_agree(monkeypatch, n_modes):
+    # femmech.linalg.dense_symmetric solves the shift-inverted pencil for all pairs
+    # (sygvd, 8 of 30 wanted) or the wanted ones (sygvx, 3 of 30, the sweep's frozen-angle
+    # solves): both give the same lowest pairs to round-off, with a massless coordinate
+    # (infinite λ, dropped) and with a rigid-body mode (singular C: its μ = 1/(0 - σ)
+    # dominates, and the round-off of the others grows to ~eps·λ/|σ|, here ~1e-11).
+    from femmech import linalg
+
+    rng = np.random.default_rng(7)
+    n = 30
+    A, B = rng.standard_normal((n, n)), rng.standard_normal((n, n))
+    M = B @ B.T / n + np.eye(n)
+    M[-1], M[:, -1] = 0.0, 0.0
+    C = A @ A.T + n * np.eye(n)
+    free = np.eye(n) - np.full((n, n), 1.0 / n)  # removes the rigid motion (1, ..., 1)
+    assert 3 < linalg.ALL_PAIRS_FRACTION * n < 8
+    for stiffness, rtol in ((C, 1e-12), (free @ C @ free, 1e-9)):
+        lam, V = linalg.dense_symmetric(stiffness, M, n_modes)
+        other = 2.0 if n_modes == 8 else 0.0  # the other driver
+        monkeypatch.setattr(linalg, "ALL_PAIRS_FRACTION", other)
+        lam_ref, V_ref = linalg.dense_symmetric(stiffness, M, n_modes)
+        monkeypatch.undo()
+        assert lam.size == n_modes
+        assert_allclose(lam, lam_ref, rtol=rtol, atol=1e-12 * lam[-1])
+        assert_allclose(V.T @ M @ V, np.eye(n_modes), atol=1e-10)
+        assert_allclose(np.abs(np.einsum("ij,ij->j", V, M @ V_ref)), 1.0, rtol=1e-9)
+    assert abs(lam[0]) < 1e-10 * lam[-1]  # the rigid-body mode
+
+
+def test_subspace_mac_equals_pseudo_inverse_formula():
+    # subspace_mac (eigen-decomposed Gram of each group) against the pseudo-inverse
+    # formula x̄ᵀ W Y_g (Y_gᴴ W Y_g)⁺ Y_gᴴ W x / (xᴴ W x), with a rank-deficient group.
+    from femmech.analysis.sweep import subspace_mac
+
+    rng = np.random.default_rng(11)
+    n = 12
+    A = rng.standard_normal((n, n))
+    W = A @ A.T + n * np.eye(n)
+    X, Y = rng.standard_normal((n, 4)), rng.standard_normal((n, 6))
+    Y[:, 2] = Y[:, 0] - 2.0 * Y[:, 1]  # group [0, 1, 2] spans two dimensions only
+    groups = [np.array([0, 1, 2]), np.array([3]), np.array([4, 5])]
+    expected = np.empty((4, 6))
+    nx = np.einsum("ij,ij->j", X, W @ X)
+    for g in groups:
+        P = Y[:, g].T @ W @ X
+        coef = np.linalg.pinv(Y[:, g].T @ W @ Y[:, g], rcond=1e-12, hermitian=True) @ P
+        expected[:, g] = (np.einsum("ij,ij->j", P, coef) / nx)[:, None]
+    assert_allclose(subspace_mac(X, Y, groups, W), expected, rtol=1e-10)
+    assert_allclose(subspace_mac(X, Y[:, 3:4], [np.array([0])], W)[:, 0],
+                    mac_matrix(X, Y[:, 3:4], W)[:, 0], rtol=1e-12)
+
+
+def test_sweep_threads_follow_femmech_threads(monkeypatch, cam_model):
+    # The per-angle solves run in femmech.threads' solve phase (1 BLAS thread by
+    # default); the former blas_threads argument still works but is deprecated.
+    import warnings
+
+    from threadpoolctl import threadpool_info
+
+    import femmech.analysis.sweep as sweep_module
+    from femmech import threads
+
+    system = couple(craig_bampton(_beam(), "mid", n_modes=6),
+                    [Mount(cam_model, (Attachment("y_g", 20, "uy"),))])
+    seen, solve = [], sweep_module.frozen_modes
+
+    def spy(*args, **kwargs):
+        seen.append({lib["num_threads"] for lib in threadpool_info()})
+        return solve(*args, **kwargs)
+
+    monkeypatch.setattr(sweep_module, "frozen_modes", spy)
+    with threads.limit(solve=1), warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = sweep(system, PHI[:3], n_modes=3)
+    assert seen
+    assert all(s == {1} for s in seen)
+    with pytest.warns(DeprecationWarning, match="blas_threads") as record:
+        old = sweep(system, PHI[:3], n_modes=3, blas_threads=1)
+    assert record[0].filename == __file__
+    assert_allclose(old.eigenvalues, result.eigenvalues, rtol=0)

@@ -17,14 +17,16 @@ are kept and flagged (:attr:`Sweep.unstable`), never reported as plain frequenci
 
 from __future__ import annotations
 
+import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
-from threadpoolctl import threadpool_limits
 
-from femmech.coupling import CoupledSystem, assemble_at
+from femmech import threads
+from femmech.coupling import CoupledSystem
 from femmech.linalg import dense_symmetric
 
 SYMMETRY_RTOL = 1e-10
@@ -43,6 +45,8 @@ ZERO_RTOL = 1e-12
 
 UNSTABLE_RTOL = 1e-9
 """A branch is flagged unstable where its damping ratio is below ``-UNSTABLE_RTOL``."""
+
+_SOLVE_PHASE = object()  # default of the deprecated ``blas_threads``: femmech.threads
 
 
 @dataclass(frozen=True)
@@ -91,17 +95,18 @@ class Sweep:
 def frozen_modes(M, B, C, n_modes: int, damped: bool = False, H=None):
     """Lowest quasi-modes at one angle (dense): (eigenvalues, freq_hz, ratio, V, form).
 
-    With constraints ``H x = 0`` (multiplier form), the undamped problem is solved as
-    ``[[C, Hᵀ], [H, 0]] [v; μ] = λ [[M, 0], [0, 0]] [v; μ]`` (seed 5.2.1 eq. 21 for
-    harmonic motion); μ are the interface forces of the mode.
+    M, B, C (n, n): mass, damping (read only if ``damped``, otherwise it may be None)
+    and stiffness. With constraints ``H x = 0`` (multiplier form), the undamped problem is
+    solved as ``[[C, Hᵀ], [H, 0]] [v; μ] = λ [[M, 0], [0, 0]] [v; μ]`` (seed 5.2.1
+    eq. 21 for harmonic motion); μ are the interface forces of the mode.
     """
-    M, B, C = (np.asarray(A) for A in (M, B, C))
+    M, C = np.asarray(M), np.asarray(C)
     scale = _lambda_scale(M, C)
     symmetric = np.abs(C - C.T).max() <= SYMMETRY_RTOL * max(np.abs(C).max(), 1e-300)
     if H is not None and len(H):
         return _constrained_modes(M, C, np.asarray(H), n_modes, damped, symmetric, scale)
     if damped:
-        return _damped_modes(M, B, C, n_modes, scale)
+        return _damped_modes(M, np.asarray(B), C, n_modes, scale)
     if symmetric:
         try:
             lam, V = dense_symmetric(0.5 * (C + C.T), M, n_modes)
@@ -203,8 +208,14 @@ def mac_matrix(X, Y, W=None) -> np.ndarray:
 def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0,
           n_modes: int = 6, damped: bool = False, track: bool = True,
           keep_vectors: bool = False, frequency_weight: float = 0.1,
-          blas_threads: int | None = 1) -> Sweep:
+          blas_threads=_SOLVE_PHASE) -> Sweep:
     """Quasi-modes of a coupled machine at many drive angles, with mode tracking.
+
+    The mechanism matrices are evaluated for all angles at once
+    (:meth:`~femmech.coupling.CoupledSystem.mechanism_blocks`); the per-angle solves run
+    under :func:`femmech.threads.solve_phase` (one BLAS thread by default: many small
+    dense solves run fastest so; on this project's 2-core machine under load, 2 threads
+    made a 271-coordinate sweep 25x slower).
 
     Parameters
     ----------
@@ -227,10 +238,9 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
     frequency_weight : float
         Weight of the relative frequency jump against ``1 - MAC`` in the assignment.
     blas_threads : int or None
-        BLAS threads during the per-angle solves (threadpoolctl); ``None`` leaves the
-        setting alone. Many small dense solves run fastest on one thread: on this
-        project's 2-core machine under load, 2 threads made a 271-coordinate sweep 25x
-        slower (255 vs 11 ms per angle, benchmarks/coupled_sweep.py).
+        Deprecated (DeprecationWarning): set the threads with
+        ``femmech.threads.limit(solve=n)`` or ``FEMMECH_THREADS``. Given, it is the solve
+        limit of this call (``None``: leave the libraries alone).
 
     Returns
     -------
@@ -244,19 +254,15 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
     if not 0 < n_modes < system.n:
         raise ValueError(f"n_modes must lie in 1..{system.n - 1}, got {n_modes}")
     extra = min(n_modes + max(2, n_modes // 2), system.n - (0 if damped else 1))
-    blocks = system.mechanism_blocks(phi, Omega, Omega_dot)
-
-    def matrices(a):
-        return assemble_at(system, blocks, a)[:3]
-
-    with threadpool_limits(limits=blas_threads, user_api="blas"):
+    matrices = _angle_matrices(system, phi, Omega, Omega_dot, damped)
+    with _solve_phase(blas_threads):
         return _sweep_loop(matrices, system.n, system.H, phi, n_modes, extra, damped, track,
                            keep_vectors, frequency_weight)
 
 
 def parameter_sweep(system_at, values, phi: float = 0.0, n_modes: int = 6,
                     damped: bool = False, keep_vectors: bool = False,
-                    frequency_weight: float = 0.1, blas_threads: int | None = 1) -> Sweep:
+                    frequency_weight: float = 0.1, blas_threads=_SOLVE_PHASE) -> Sweep:
     """Quasi-modes at a fixed drive angle over a parameter, with mode tracking.
 
     Parameters
@@ -289,9 +295,58 @@ def parameter_sweep(system_at, values, phi: float = 0.0, n_modes: int = 6,
                              f" coordinates, the first one {first.n}")
         return system.matrices(phi, Omega)[:3]
 
-    with threadpool_limits(limits=blas_threads, user_api="blas"):
+    with _solve_phase(blas_threads):
         return _sweep_loop(matrices, first.n, first.H, values, n_modes, extra, damped, True,
                            keep_vectors, frequency_weight)
+
+
+@contextmanager
+def _solve_phase(blas_threads):
+    """:func:`femmech.threads.solve_phase`, with the deprecated ``blas_threads`` (if
+    given) as the solve limit."""
+    if blas_threads is _SOLVE_PHASE:
+        with threads.solve_phase():
+            yield
+        return
+    warnings.warn("blas_threads is deprecated: the sweeps run under femmech.threads"
+                  " (femmech.threads.limit(solve=n) or FEMMECH_THREADS='solve=n')",
+                  DeprecationWarning, stacklevel=4)
+    with threads.limit(solve=blas_threads), threads.solve_phase():
+        yield
+
+
+def _angle_matrices(system: CoupledSystem, phi, Omega, Omega_dot, damped: bool):
+    """``matrices(a) -> (M, B, C)`` (n, n) at angle ``phi[a]``, equal to
+    :func:`femmech.coupling.assemble_at` to round-off; B is None unless ``damped``.
+
+    The mechanism blocks are evaluated for all angles at once, summed per matrix entry
+    they touch (mounts may share coordinates) and added per angle with one indexed
+    update to a copy of the constant part.
+    """
+    n, n_angles = system.n, phi.size
+    blocks = system.mechanism_blocks(phi, Omega, Omega_dot)
+    flat = [(idx[:, None] * n + idx).ravel() for idx in system.touched]
+    where = np.unique(np.concatenate([np.zeros(0, dtype=int), *flat]))
+    entries = [np.searchsorted(where, f) for f in flat]
+
+    def summed(k):  # (n_angles, where.size): values of matrix k (0 M, 1 B, 2 C)
+        out = np.zeros((n_angles, where.size))
+        for e, b in zip(entries, blocks, strict=True):
+            out[:, e] += b[k].reshape(n_angles, -1)  # e: distinct entries of one mount
+        return out
+
+    parts = {k: (A.ravel(), summed(k)) for k, A in enumerate((system.M0, system.B0, system.K0))
+             if damped or k != 1}
+
+    def matrices(a):
+        out = [None] * 3
+        for k, (constant, values) in parts.items():
+            A = constant.copy()
+            A[where] += values[a]
+            out[k] = A.reshape(n, n)
+        return tuple(out)
+
+    return matrices
 
 
 def _sweep_loop(matrices, n, H, phi, n_modes, extra, damped, track, keep_vectors,
@@ -303,26 +358,28 @@ def _sweep_loop(matrices, n, H, phi, n_modes, extra, damped, track, keep_vectors
     mac_step = np.ones((n_angles, n_modes))
     vectors = np.zeros((n_angles, n, n_modes), dtype=complex) if keep_vectors else None
     forms, previous = set(), None
+    limit = n - (0 if damped else 1)
     for a in range(n_angles):
         M, B, C = matrices(a)
         ev, f, r, V, form = frozen_modes(M, B, C, extra, damped, H)
-        limit = n - (0 if damped else 1)
-        while track and ev.size == extra < limit and _cuts_cluster(f, n_modes):
+        groups = clusters(f) if track else None
+        while track and ev.size == extra < limit and _cuts_cluster(groups, f.size, n_modes):
             extra = min(2 * extra, limit)  # complete the cluster (kept for later angles)
             ev, f, r, V, form = frozen_modes(M, B, C, extra, damped, H)
+            groups = clusters(f)
         if ev.size < n_modes:
             raise ValueError(f"at {phi[a]:.6g}: only {ev.size} finite quasi-modes (massless"
                              " coordinates have infinite eigenvalues); ask for at most"
                              f" {ev.size} modes")
         forms.add(form)
         if track and previous is not None:
-            pick, macs = _assign(previous, V, f, M, frequency_weight)
+            pick, macs = _assign(previous, V, f, groups, M, frequency_weight)
         else:
             pick, macs = np.arange(n_modes), np.ones(n_modes)
         lam[a], freq[a], ratio[a], mac_step[a] = ev[pick], f[pick], r[pick], macs
         previous = (V[:, pick], f[pick])
         if keep_vectors:
-            vectors[a] = V[:, pick]
+            vectors[a] = previous[0]
     form = "damped" if "damped" in forms else ("unsymmetric" if "unsymmetric" in forms
                                                 else "symmetric")
     if vectors is not None and form == "symmetric":
@@ -330,7 +387,7 @@ def _sweep_loop(matrices, n, H, phi, n_modes, extra, damped, track, keep_vectors
     return Sweep(phi, freq, lam, ratio, vectors, mac_step, form)
 
 
-def _assign(previous, V, f, M, weight):
+def _assign(previous, V, f, groups, M, weight):
     """Columns of V continuing each previous branch (Hungarian assignment).
 
     The similarity of a previous branch i and a candidate j is the larger of two
@@ -339,38 +396,41 @@ def _assign(previous, V, f, M, weight):
     branch thus stays in its cluster although the cluster's vectors are an arbitrary
     basis, and a cluster that splits (or forms) is followed. Within a cluster the
     vector MAC breaks ties (``0.1 × (subspace MAC - MAC)``), so that close but distinct
-    modes, e.g. at a crossing, keep their identity.
+    modes, e.g. at a crossing, keep their identity. ``groups``: the clusters of f. All
+    M-products come from one Gram matrix of the previous and the new vectors.
     """
     V_prev, f_prev = previous
-    mac = mac_matrix(V_prev, V, M)
-    sub = np.maximum(subspace_mac(V_prev, V, clusters(f), M),
-                     subspace_mac(V, V_prev, clusters(f_prev), M).T)
-    jump = np.abs(f[None, :] - f_prev[:, None]) / np.maximum(f_prev[:, None], 1e-12)
-    rows, cols = linear_sum_assignment(1.0 - sub + weight * jump + 0.1 * (sub - mac))
-    order = np.argsort(rows)
-    pick = cols[order]
-    return pick, sub[rows[order], pick]
+    p = V_prev.shape[1]
+    Z = np.concatenate((V_prev, V), axis=1)
+    G = Z.conj().T @ (M @ Z)  # (p + q, p + q)
+    norms = G.diagonal().real
+    S = G[:p, p:]
+    mac = np.abs(S) ** 2 / (norms[:p, None] * norms[p:])
+    sub = np.maximum(_span_mac(S, norms[:p], G[p:, p:], groups, mac),
+                     _span_mac(S.conj().T, norms[p:], G[:p, :p], clusters(f_prev), mac.T).T)
+    jump = np.abs(f - f_prev[:, None]) / np.maximum(f_prev, 1e-12)[:, None]
+    rows, pick = linear_sum_assignment(1.0 - sub + weight * jump + 0.1 * (sub - mac))
+    return pick, sub[rows, pick]  # rows = 0..p-1 (p <= q: every branch is assigned)
 
 
-def _cuts_cluster(freq_hz, n_modes: int) -> bool:
+def _cuts_cluster(groups, n_candidates: int, n_modes: int) -> bool:
     """True if the last computed frequency is in the cluster of the n-th lowest: the
-    candidates then hold only part of a cluster, whose span tracking needs whole."""
-    groups = clusters(freq_hz)
-    order = np.argsort(freq_hz, kind="stable")
-    where = {int(i): k for k, g in enumerate(groups) for i in g}
-    return where[int(order[n_modes - 1])] == where[int(order[-1])]
+    candidates then hold only part of a cluster, whose span tracking needs whole.
+    ``groups``: :func:`clusters` of the candidates (ascending, so the last group holds
+    the highest)."""
+    return n_candidates - groups[-1].size < n_modes
 
 
 def clusters(freq_hz, rtol: float = CLUSTER_RTOL) -> list[np.ndarray]:
-    """Groups of indices of close frequencies: sorted neighbours closer than ``rtol``
-    times the frequency (frequencies below 1e-3 of the largest count as that size, so
-    rigid-body modes at round-off form one group)."""
+    """Groups of indices of close frequencies, in ascending order of frequency: sorted
+    neighbours closer than ``rtol`` times the frequency (frequencies below 1e-3 of the
+    largest count as that size, so rigid-body modes at round-off form one group)."""
     freq = np.asarray(freq_hz, dtype=float)
     order = np.argsort(freq, kind="stable")
     f = freq[order]
-    size = np.maximum(f, 1e-3 * max(float(np.abs(f).max(initial=0.0)), 1e-300))
-    breaks = np.flatnonzero(np.diff(f) > rtol * size[1:])
-    return np.split(order, breaks + 1)
+    size = np.maximum(f[1:], 1e-3 * max(float(np.abs(f).max(initial=0.0)), 1e-300))
+    bounds = [0, *(np.flatnonzero(f[1:] - f[:-1] > rtol * size) + 1).tolist(), f.size]
+    return [order[i:j] for i, j in zip(bounds[:-1], bounds[1:], strict=True)]
 
 
 def subspace_mac(X, Y, groups, W=None) -> np.ndarray:
@@ -378,14 +438,23 @@ def subspace_mac(X, Y, groups, W=None) -> np.ndarray:
     group holding j: ``x̄ᵀ W Y_g (Y_gᴴ W Y_g)⁺ Y_gᴴ W x / (xᴴ W x)`` (1 if x lies in it).
     A group of one column gives the plain MAC."""
     WX = X if W is None else W @ X
+    WY = Y if W is None else W @ Y
+    S = X.conj().T @ WY
     nx = np.real(np.einsum("ij,ij->j", X.conj(), WX))
-    out = np.empty((X.shape[1], Y.shape[1]))
+    G = Y.conj().T @ WY
+    return _span_mac(S, nx, G, groups, np.abs(S) ** 2 / np.outer(nx, G.diagonal().real))
+
+
+def _span_mac(S, nx, G, groups, mac) -> np.ndarray:
+    """:func:`subspace_mac` from the products ``S = Xᴴ W Y`` (p, q), ``nx = diag(Xᴴ W X)``
+    (p,) and ``G = Yᴴ W Y`` (q, q); ``mac`` (p, q), the plain MAC, serves groups of one."""
+    out = mac.copy()
     for g in groups:
-        Yg = Y[:, g]
-        P = Yg.conj().T @ WX
-        G = Yg.conj().T @ (Yg if W is None else W @ Yg)
-        coef = np.linalg.pinv(G, rcond=1e-12, hermitian=True) @ P
-        out[:, g] = (np.real(np.einsum("ij,ij->j", P.conj(), coef)) / nx)[:, None]
+        if g.size > 1:  # P G_g⁺ Pᴴ with G_g = U diag(w) Uᴴ, w below 1e-12 max|w| dropped
+            w, U = np.linalg.eigh(G[g[:, None], g])
+            keep = w > 1e-12 * np.abs(w).max()
+            T = S[:, g] @ U[:, keep]
+            out[:, g] = ((np.abs(T) ** 2 / w[keep]).sum(axis=1) / nx)[:, None]
     return out
 
 
