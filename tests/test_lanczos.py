@@ -216,3 +216,28 @@ def test_sturm_check_completes_a_cluster_of_twelve_cut_by_n_modes():
         assert n == np.count_nonzero(lam <= result.cut)
         assert_allclose(result.omega2, lam[:n], rtol=1e-10)
         assert result.residual.max() < 1e-8
+
+
+def test_far_default_shift_is_moved_towards_the_wanted_eigenvalues():
+    """A 500-mass chain (eigenvalues ~99 (2j - 1)² rad²/s²) beside 1 500 very stiff
+    coordinates (1e13 N/m on 1 kg each, like stiff contacts): the default shift
+    -1e-6 median(K_ii/M_ii) = -1e7 lies 1e5 times further below zero than λ_1 is above
+    it, so θ = 1/(λ - σ) of the 20 wanted differ by 1 % only. The solver moves σ to
+    -max(λ_1, 1e-3 |σ|) = -1e4 (linalg.FAR_SHIFT) and factorises again; the result
+    equals the dense reference and passes the Sturm check."""
+    n_chain, k_chain = 500, 1e7
+    main = np.full(n_chain, 2 * k_chain)
+    main[-1] = k_chain  # free end; fixed at the other
+    chain = sp.diags([main, -k_chain * np.ones(n_chain - 1), -k_chain * np.ones(n_chain - 1)],
+                     [0, 1, -1])
+    K = sp.block_diag([chain, sp.diags(np.full(3 * n_chain, 1e13))]).tocsr()
+    M = sp.identity(4 * n_chain, format="csr")
+    lam = np.linalg.eigvalsh(chain.toarray())  # the stiff ones are all 1e13
+    default = linalg.default_shift(K, M)
+    assert -default > 1e4 * lam[0]  # far below: the case of linalg.FAR_SHIFT
+    result = solve_symmetric(K, M, n_modes=20)
+    assert result.sigma == pytest.approx(-1e-3 * -default)  # moved, bounded by 1e-3 |σ|
+    assert result.sturm_count == result.omega2.size == 20
+    # dense reference (eigvalsh of the chain, ~eps λ_max(chain) = 1e-8 absolute, 1e-10
+    # of λ_1): measured 3e-12; at the unmoved shift 8.5e-10, with residuals of 1.3e-5
+    assert_allclose(result.omega2, lam[:20], rtol=1e-10)
