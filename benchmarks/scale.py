@@ -5,9 +5,9 @@ Model (:func:`machine_bed`): a welded machine bed, a rectangular steel box of 6 
 membrane + drilling, :mod:`femmech.elements.shell`; ``n`` quads per 0.2 m), stiffened by
 ring frames (box-section beams 60 x 60 x 5 mm round the perimeter every 0.2 m) and two
 top rails (80 x 80 x 6 mm along the top edges), standing on four feet (all DOFs of the
-bottom-plate nodes within 0.2 m of either end fixed). Sizes: ``n = 1, 6, 12, 24`` give
-1 764, 61 320, 243 936 and 969 696 free DOFs (``"tiny"``, ``"small"``, ``"medium"``,
-``"large"``).
+bottom-plate nodes within 0.2 m of either end fixed). Sizes ``"tiny"``, ``"small"``,
+``"medium"``, ``"large"``: ``n = 1, 6, 12, 24``, 1 788, 61 008, 242 952 and 969 720 DOFs
+(1 548, 58 692, 234 630 and 937 926 free).
 
 Machine: a cam shaft on four bearing seats on the top plate, each seat an RBE2 spider
 (:class:`~femmech.RigidLink`) from the bearing centre 80 mm above the plate to the plate
