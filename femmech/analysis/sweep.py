@@ -46,7 +46,14 @@ ZERO_RTOL = 1e-12
 UNSTABLE_RTOL = 1e-9
 """A branch is flagged unstable where its damping ratio is below ``-UNSTABLE_RTOL``."""
 
-_SOLVE_PHASE = object()  # default of the deprecated ``blas_threads``: femmech.threads
+class _SolvePhase:
+    """Default of the deprecated ``blas_threads``: the limits of :mod:`femmech.threads`."""
+
+    def __repr__(self):
+        return "femmech.threads"
+
+
+_SOLVE_PHASE = _SolvePhase()
 
 
 @dataclass(frozen=True)
