@@ -778,8 +778,8 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
         try:
             omega2, X = _lowest_pairs(K, M, k, sigma, lu, n_wanted=n_modes, far_check=movable)
         except _FarShift as far:
-            sigma, movable = far.shift, False
-            lu = factorize(K - sigma * M, definite=None if sigma < 0 else False)
+            sigma, movable = far.shift, False  # (the same ordering: no new analysis)
+            lu = lu.factorize_like(K - sigma * M, definite=None if sigma < 0 else False)
             continue
         count = _complete_cluster(omega2, n_modes)
         if count < k or k == limit:

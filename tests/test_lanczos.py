@@ -241,3 +241,16 @@ def test_far_default_shift_is_moved_towards_the_wanted_eigenvalues():
     # dense reference (eigvalsh of the chain, ~eps λ_max(chain) = 1e-8 absolute, 1e-10
     # of λ_1): measured 3e-12; at the unmoved shift 8.5e-10, with residuals of 1.3e-5
     assert_allclose(result.omega2, lam[:20], rtol=1e-10)
+
+
+def test_arpack_takes_over_where_block_lanczos_does_not_converge(pencil, monkeypatch):
+    """With no solves allowed (MAX_SOLVES_PER_MODE = -1e9) block Lanczos gives up at
+    once; solve_symmetric warns and ARPACK returns the same modes (dense reference,
+    round-off of the shift-inverted pencil)."""
+    K, M, _, _, _ = pencil
+    expected = dense_symmetric(K, M, 8)[0]
+    monkeypatch.setattr(linalg, "MAX_SOLVES_PER_MODE", -10**9)
+    with pytest.warns(fm.FemmechWarning, match="falling back to ARPACK"):
+        result = solve_symmetric(K, M, n_modes=8, dense_below=0)
+    assert result.sturm_count == result.omega2.size >= 8
+    assert_allclose(result.omega2[:8], expected, rtol=1e-9)
