@@ -311,7 +311,7 @@ without convergence (normal runs take 3-5 per mode) it gives up and ARPACK takes
 _EPS = float(np.finfo(float).eps)
 
 
-class _NotConverged(RuntimeError):
+class _NotConvergedError(RuntimeError):
     """:func:`_block_lanczos` reached :data:`MAX_SOLVES_PER_MODE`."""
 
 
@@ -330,7 +330,7 @@ is what makes their solves accurate (a free thin shell moved to -λ_1 had rigid-
 residuals of 1.5e-6); frames and shells of the benchmarks have -σ / λ_1 = 0.2-1."""
 
 
-class _FarShift(RuntimeError):
+class _FarShiftError(RuntimeError):
     """:func:`_block_lanczos` found σ far below the wanted eigenvalues; ``shift`` is a
     better one (rad²/s²)."""
 
@@ -341,11 +341,11 @@ class _FarShift(RuntimeError):
 
 def _lowest_pairs(K, M, k, sigma, lu, deflate=None, n_wanted=None, far_check=False):
     """``k`` eigenpairs nearest σ: block Lanczos, ARPACK where it does not converge.
-    ``far_check``: raise :class:`_FarShift` where σ is too far (:data:`FAR_SHIFT`)."""
+    ``far_check``: raise :class:`_FarShiftError` where σ is too far (:data:`FAR_SHIFT`)."""
     try:
         return _block_lanczos(K, M, k, sigma, lu, deflate=deflate, n_wanted=n_wanted,
                               far_check=far_check)
-    except _NotConverged as exc:
+    except _NotConvergedError as exc:
         warnings.warn(f"{exc}; falling back to ARPACK", FemmechWarning, stacklevel=3)
         return _arpack(K, M, k, sigma, lu, deflate=deflate)
 
@@ -502,7 +502,7 @@ def _block_lanczos(K, M, k, sigma, lu, deflate=None, block=BLOCK_SIZE, tol=LANCZ
         solved, max_solved = m, MAX_SOLVES_PER_MODE * k + 400
         while True:
             if solved > max_solved:
-                raise _NotConverged(f"block Lanczos: {k} eigenpairs near σ = {sigma:.6g}"
+                raise _NotConvergedError(f"block Lanczos: {k} eigenpairs near σ = {sigma:.6g}"
                                     f" not converged after {solved} solves")
             SQ = operator(MV[:, j0:m])
             solved += m - j0
@@ -574,7 +574,7 @@ def _block_lanczos(K, M, k, sigma, lu, deflate=None, block=BLOCK_SIZE, tol=LANCZ
                 lam = sigma + 1.0 / theta[:k]
                 low = lam.min()  # no rigid-body modes (|λ| ~ 0) and no negative ones
                 if sigma < 0 and low > 1e-6 * -sigma and -sigma > FAR_SHIFT * low:
-                    raise _FarShift(-max(low, 1e-3 * -sigma))
+                    raise _FarShiftError(-max(low, 1e-3 * -sigma))
             if converged(theta, est) or (b == 0 and m >= krylov):
                 break
             if b < block and m + b < krylov:  # Krylov space (nearly) invariant: widen it
@@ -777,7 +777,7 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
                              " modes")
         try:
             omega2, X = _lowest_pairs(K, M, k, sigma, lu, n_wanted=n_modes, far_check=movable)
-        except _FarShift as far:
+        except _FarShiftError as far:
             sigma, movable = far.shift, False  # (the same ordering: no new analysis)
             lu = lu.factorize_like(K - sigma * M, definite=None if sigma < 0 else False)
             continue
