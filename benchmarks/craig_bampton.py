@@ -40,7 +40,7 @@ import femmech as fm
 from femmech import reduction
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from frame_modes import _table, machine_info, write_report  # noqa: E402  (sibling benchmark)
+from frame_modes import _table, machine_info, publish  # noqa: E402  (sibling benchmark)
 from solvers import MODELS  # noqa: E402
 from solvers import build as build_model  # noqa: E402
 
@@ -155,11 +155,7 @@ def main(sizes=("20k", "150k"), n_modes: int = N_MODES, interfaces=INTERFACES,
         if echo:
             print(f"... {case} done", file=sys.stderr, flush=True)
     if echo or out_file is not None:
-        text = "\n".join(machine_info() + [""] + format_tables(rows))
-        if echo:
-            print(text)
-        if out_file is not None:
-            write_report(out_file, text)
+        publish("\n".join(machine_info() + [""] + format_tables(rows)), out_file, echo)
     return rows
 
 

@@ -70,7 +70,7 @@ from craig_bampton import (  # noqa: E402  (sibling benchmark: models and helper
     max_error,
     reduced_frequencies,
 )
-from frame_modes import _table, machine_info, write_report  # noqa: E402
+from frame_modes import _table, machine_info, publish  # noqa: E402
 from solvers import build as build_model  # noqa: E402
 
 INTERFACE = "8 joints"
@@ -245,11 +245,8 @@ def main(sizes=("20k", "150k"), n_modes: int = N_MODES,
                 print(f"... {case} done", file=sys.stderr, flush=True)
     if echo or out_file is not None:
         body = format_tables(rows) if version else not_installed_lines()
-        text = "\n".join(machine_info() + [f"exudyn {version or 'not installed'}", ""] + body)
-        if echo:
-            print(text)
-        if out_file is not None:
-            write_report(out_file, text)
+        publish("\n".join(machine_info() + [f"exudyn {version or 'not installed'}", ""] + body),
+                out_file, echo)
     return rows
 
 

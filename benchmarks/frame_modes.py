@@ -507,11 +507,7 @@ def main(sizes=("small", "medium", "large"), with_slow_reference=False,
             gc.collect()
             if echo:
                 print(f"... {name} done", file=sys.stderr, flush=True)
-    text = "\n".join(machine_info() + [""] + format_tables(rows))
-    if echo:
-        print(text)
-    if out_file is not None:
-        write_report(out_file, text)
+    publish("\n".join(machine_info() + [""] + format_tables(rows)), out_file, echo)
     return rows
 
 
@@ -522,6 +518,14 @@ def write_report(out_file, text: str) -> Path:
     with atomic_path(out_file) as tmp:
         tmp.write_text(text + "\n")
     return out_file
+
+
+def publish(text: str, out_file=None, echo: bool = True) -> None:
+    """Print a report (``echo``) and write it to ``out_file`` (None: not written)."""
+    if echo:
+        print(text)
+    if out_file is not None:
+        write_report(out_file, text)
 
 
 def _cli(argv=None):

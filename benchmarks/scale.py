@@ -288,11 +288,7 @@ def main(size: str = "large", n_angles: int = N_ANGLES, n_check: int = 0,
     """Run :func:`run` and print / write the report (``out_file=None``: not written)."""
     row = run(size, n_angles, n_check)
     row["sweep_angles"] = n_angles
-    text = "\n".join(format_report(row))
-    if echo:
-        print(text)
-    if out_file is not None:
-        fmb.write_report(out_file, text)
+    fmb.publish("\n".join(format_report(row)), out_file, echo)
     return row
 
 

@@ -183,11 +183,7 @@ def main(sizes=("small", "medium", "large"), with_slow_reference=False,
     header = fmb.machine_info() + [
         f"models: box girder {BOX[0]} x {BOX[1]} x {BOX[2]} m, t = {THICKNESS * 1e3:g} mm"
         " steel, MITC4 quads, clamped at both ends; n quads per 0.2 m"]
-    text = "\n".join(header + [""] + format_tables(rows))
-    if echo:
-        print(text)
-    if out_file is not None:
-        fmb.write_report(out_file, text)
+    fmb.publish("\n".join(header + [""] + format_tables(rows)), out_file, echo)
     return rows
 
 

@@ -50,7 +50,7 @@ from frame_modes import (  # noqa: E402  (sibling benchmark: shared measurement 
     _table,
     machine_info,
     peak_memory,
-    write_report,
+    publish,
 )
 
 N_MODES = 20
@@ -229,11 +229,7 @@ def main(sizes=("20k", "150k"), names=None,
         rows += model_rows(case, names)
         if echo:
             print(f"... {case} done", file=sys.stderr, flush=True)
-    text = "\n".join(header() + [""] + format_tables(rows))
-    if echo:
-        print(text)
-    if out_file is not None:
-        write_report(out_file, text)
+    publish("\n".join(header() + [""] + format_tables(rows)), out_file, echo)
     for r in rows:
         r.pop("omega2")
     return rows
