@@ -88,7 +88,6 @@ SIZE_CASES = {
 }
 SLOW_REFERENCE_DOFS = 200_000  # eigsh with default SuperLU above this only with the flag
 DENSE_REFERENCE_DOFS = 12_000  # dense eigh up to this size
-M_MMAP_THRESHOLD = -3  # mallopt parameter (glibc malloc.h)
 
 
 # --- measurement helpers -------------------------------------------------------------
@@ -147,6 +146,7 @@ def _status_kib(field: str) -> int:
 def peak_memory(out: dict, key: str):
     """Store in ``out[key]`` the peak resident memory (MB) above the start of the block."""
     gc.collect()
+    _return_freed_memory()
     try:
         with open("/proc/self/clear_refs", "w") as fh:
             fh.write("5")  # reset the high-water mark VmHWM to the current RSS
@@ -162,14 +162,18 @@ def peak_memory(out: dict, key: str):
 
 
 def _return_freed_memory():
-    """Serve arrays above 128 KiB by mmap, so that freed ones leave the resident set.
+    """Give the heap's free memory back to the system (glibc ``malloc_trim``).
 
-    glibc raises its mmap threshold (up to 32 MiB) after large frees; freed heap memory
-    then stays resident and hides the next phase's allocations from the peak measurement.
+    Called before each peak measurement (:func:`peak_memory`), so that memory an earlier
+    phase freed and the allocator kept does not hide the next phase's allocations from
+    the peak. The allocator otherwise keeps its defaults, as in a user's script: freed
+    temporaries are reused within a phase. (Until stop 13 the benchmarks served every
+    array above 128 KiB by mmap instead; the page faults of the temporaries then made
+    the Lanczos loop of the 151k-DOF frame 1.6-1.9x slower than in a plain run.)
     """
     try:
-        ctypes.CDLL("libc.so.6").mallopt(M_MMAP_THRESHOLD, 128 * 1024)
-    except OSError:
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
         pass
 
 

@@ -45,7 +45,6 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from threadpoolctl import threadpool_limits
 
 from femmech import threads
 
@@ -383,6 +382,7 @@ def _mkl():
             lib.pardiso_getdiag.argtypes = [vp, vp, vp, i32, i32]
             lib.pardiso_getdiag.restype = None
             _MKL = lib
+            threads.refresh()  # MKL's threads are limited from now on
             break
     return _MKL or None
 
@@ -516,7 +516,7 @@ class PardisoFactor(Factor):
     def _numeric(self, a):
         start = time.perf_counter()
         self._a = np.ascontiguousarray(a, dtype=float)
-        with threadpool_limits(limits=self._threads):
+        with threads.exactly(self._threads):
             self._call(22, self._a)
         self.timings["factorise"] = time.perf_counter() - start
         if self.iparm[13] > 0:  # perturbed pivots: A is singular to working precision

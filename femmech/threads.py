@@ -24,7 +24,7 @@ import os
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 
-from threadpoolctl import threadpool_info, threadpool_limits
+from threadpoolctl import ThreadpoolController, threadpool_info
 
 ENV_VAR = "FEMMECH_THREADS"
 _KEEP = object()
@@ -117,17 +117,88 @@ def limit(solve=_KEEP, factor=_KEEP):
         set_threads(previous.solve, previous.factor)
 
 
+_controller: ThreadpoolController | None = None
+_controller_key = None
+
+
+def refresh():
+    """Forget the cached list of loaded libraries (call after loading one by hand, e.g.
+    through ctypes); the next phase looks them up again."""
+    global _controller
+    _controller = None
+
+
+def _libraries() -> ThreadpoolController:
+    """threadpoolctl's controller of the loaded BLAS/OpenMP libraries, cached.
+
+    Looking the libraries up costs ~2.5 ms (``threadpool_limits`` does it on every
+    entry); the cached controller switches in ~0.03 ms, so that loops may change the
+    limit per step (e.g. :func:`gemm_phase` inside Lanczos). The cache is renewed when
+    Python modules were imported since (new extension modules may bring a BLAS) and by
+    :func:`refresh`.
+    """
+    global _controller, _controller_key
+    import sys
+    key = len(sys.modules)
+    if _controller is None or key != _controller_key:
+        _controller, _controller_key = ThreadpoolController(), key
+    return _controller
+
+
+_outside: list = []  # thread counts before each enclosing solve phase (for gemm_phase)
+
+
+@contextmanager
+def _limited(limits):
+    if limits is None:
+        yield
+        return
+    controller = _libraries()
+    _outside.append(controller.info())
+    try:
+        with controller.limit(limits=limits):
+            yield
+    finally:
+        _outside.pop()
+
+
+@contextmanager
+def exactly(n: int):
+    """Every loaded BLAS and OpenMP library on ``n`` threads in the block."""
+    with _libraries().limit(limits=n):
+        yield
+
+
 @contextmanager
 def solve_phase():
     """Apply the *solve* limit to all loaded BLAS and OpenMP libraries in the block."""
-    with threadpool_limits(limits=_settings.solve):
+    with _limited(_settings.solve):
         yield
 
 
 @contextmanager
 def factor_phase():
     """Apply the *factor* limit to all loaded BLAS and OpenMP libraries in the block."""
-    with threadpool_limits(limits=_settings.factor):
+    with _limited(_settings.factor):
+        yield
+
+
+@contextmanager
+def gemm_phase():
+    """The *factor* limit inside a solve phase, for products that stream a large basis.
+
+    Products like ``Vᵀ W`` with V of ``n x m`` (m ~ 100, e.g. Lanczos
+    reorthogonalisation) are bound by memory bandwidth, which one core does not saturate:
+    at 151k x 88, 2 threads took 10 ms instead of 18 ms. With *factor* None the libraries'
+    counts from before the enclosing phase apply (outside any phase: no change).
+    """
+    limits = _settings.factor
+    if limits is None:
+        limits = _outside[-1] if _outside else None
+    if limits is None:
+        yield
+        return
+    with _libraries().limit(limits=limits):
         yield
 
 

@@ -278,6 +278,32 @@ def test_solve_phase_limits_every_loaded_library():
         assert all(lib["num_threads"] == 1 for lib in threadpool_info())
 
 
+
+def test_gemm_phase_inside_a_solve_phase_and_back():
+    np.ones((4, 4)) @ np.ones((4, 4))
+    counts = lambda: {lib["num_threads"] for lib in threadpool_info()}  # noqa: E731
+    outside = counts()
+    with threads.limit(solve=1, factor=None), threads.solve_phase():
+        with threads.gemm_phase():  # factor None: the counts from before the solve phase
+            assert counts() == outside
+        assert counts() == {1}
+        with threads.limit(factor=1), threads.gemm_phase():
+            assert counts() == {1}
+    assert counts() == outside
+    with threads.limit(factor=1), threads.gemm_phase():  # outside any phase: the factor limit
+        assert counts() == {1}
+    assert counts() == outside
+
+
+def test_cached_library_list_sees_libraries_loaded_later():
+    threads.refresh()
+    first = threads._libraries()
+    assert threads._libraries() is first  # cached: no new lookup (~2.5 ms each)
+    threads.refresh()
+    assert threads._libraries() is not first
+    with threads.exactly(1):
+        assert {lib["num_threads"] for lib in threadpool_info()} == {1}
+
 # --- LOBPCG ---------------------------------------------------------------------------
 
 def test_rigid_body_modes_span_the_null_space_of_a_free_model():
