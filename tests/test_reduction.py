@@ -492,3 +492,25 @@ def test_repeated_fixed_interface_modes(cube):
     # the cluster's modes are M-orthonormal (a complete, independent set)
     Mii = model.M_free[se.free_interior][:, se.free_interior]
     assert_allclose(se.Phi.T @ (Mii @ se.Phi), np.eye(cluster), atol=1e-8)
+
+
+@pytest.mark.parametrize("residual_vectors", [False, True])
+def test_projection_in_column_blocks_equals_the_dense_projection(grid, monkeypatch,
+                                                                residual_vectors):
+    # the blocked symmetric products (interfaces wider than reduction.SYMMETRIC_BLOCK)
+    # and the in-place updates give the Galerkin projection Tᵀ K T, Tᵀ M T of the
+    # superelement's own basis T = [[I, 0], [Ψ, Φ]], formed here with dense matrices
+    model = grid[0]
+    monkeypatch.setattr(reduction, "SYMMETRIC_BLOCK", 7)  # 3 + uneven blocks of n_b
+    se = craig_bampton(model, "top", n_modes=6, residual_vectors=residual_vectors)
+    n_b = se.Psi.shape[1]
+    assert n_b > 2 * reduction.SYMMETRIC_BLOCK
+    K, M = model.K_free.toarray(), model.M_free.toarray()
+    T = np.zeros((model.n_free, n_b + se.Phi.shape[1]))
+    T[se.free_interface, np.arange(n_b)] = 1.0
+    T[np.ix_(se.free_interior, np.arange(n_b))] = se.Psi
+    T[np.ix_(se.free_interior, np.arange(n_b, T.shape[1]))] = se.Phi
+    for reduced, full in ((se.K, K), (se.M, M)):
+        ref = T.T @ full @ T
+        # round-off: sums of ~n products of the entries' magnitude
+        assert_allclose(reduced, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
