@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
-from numpy.testing import assert_allclose
+from numpy.testing import assert_allclose, assert_array_equal
 from threadpoolctl import threadpool_info, threadpool_limits
 
 import femmech as fm
@@ -163,6 +163,30 @@ def test_pardiso_thread_settings_may_change_between_calls(pencil):
             x = f.solve(b)
         A2 = K + 2 * M
         assert np.linalg.norm(A2 @ x - b) <= 1e-12 * sp.linalg.norm(A2) * np.linalg.norm(x)
+
+
+def test_pardiso_parallel_block_solve_equals_the_column_loop(pencil, monkeypatch):
+    # wide blocks on sparse factors are split between copies of the factor solved
+    # concurrently (solvers.PARALLEL_SOLVE_COLUMNS); same ordering and values: the same
+    # floating-point operations per column, so the results are bitwise equal
+    if "pardiso" not in solvers.available():
+        pytest.skip("pardiso not installed")
+    K, M, _ = pencil
+    f = solvers.factorize((K + M).tocsc(), "pardiso")
+    assert f.iparm[17] < solvers.PARDISO_LOOP_FILL * f.n  # the column loop applies
+    b = np.random.default_rng(3).standard_normal((K.shape[0], 9))
+    serial = f.solve(b)
+    monkeypatch.setattr(solvers, "PARALLEL_SOLVE_COLUMNS", 4)
+    with threads.limit(factor=3):
+        parallel = f.solve(b)
+    assert len(f._twins) == 2
+    assert_array_equal(parallel, serial)
+    A2 = (K + 2 * M).tocsc()
+    f.refactor(A2)  # new values: the copies are dropped, not reused with old values
+    assert f._twins == []
+    with threads.limit(factor=2):
+        x = f.solve(b)
+    assert np.linalg.norm(A2 @ x - b) <= 1e-12 * sp.linalg.norm(A2) * np.linalg.norm(x)
 
 
 @pytest.mark.parametrize("name", FAST)
