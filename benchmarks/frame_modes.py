@@ -500,7 +500,6 @@ def main(sizes=("small", "medium", "large"), with_slow_reference=False,
         if unknown:
             raise ValueError(f"unknown sizes {unknown}; choose from {list(SIZE_CASES)}")
         plan = [SIZE_CASES[size] for size in sizes]
-    _return_freed_memory()
     rows, history = [], []
     for modal, assembly in plan:
         for name in assembly:

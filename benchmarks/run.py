@@ -319,7 +319,6 @@ def main(size: str = "small", only=None, out_dir=RESULTS, echo=True,
     unknown = [n for n in names if n not in ENTRIES]
     if unknown:
         raise ValueError(f"unknown benchmarks {unknown}; choose from {list(ENTRIES)}")
-    frame_modes._return_freed_memory()
     if out_dir is not None:
         Path(out_dir).mkdir(parents=True, exist_ok=True)
     results = {}

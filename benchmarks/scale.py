@@ -205,11 +205,11 @@ def run(size: str = "large", n_angles: int = N_ANGLES, n_check: int = 0,
     """
     if size not in SIZES:
         raise ValueError(f"unknown size {size!r}; choose from {list(SIZES)}")
-    if n_angles < 1 or n_branches < 1 or n_fixed_modes < 1:
-        raise ValueError("n_angles, n_branches and n_fixed_modes must be positive")
-    fmb._return_freed_memory()
-    gc.collect()
-    row = {"size": size, "n": SIZES[size], "solver": "?"}
+    for name, value in (("n_angles", n_angles), ("n_branches", n_branches),
+                        ("n_fixed_modes", n_fixed_modes)):
+        if value < 1:
+            raise ValueError(f"{name} must be a positive integer, got {value}")
+    row = {"size": size, "n": SIZES[size], "solver": "?", "sweep_angles": n_angles}
     mesh, groups = _timed(row, "mesh", machine_bed, SIZES[size])
     model = _timed(row, "build", build, mesh, groups)
     row.update(dofs=model.n_dof, free_dofs=model.n_free, quads=len(mesh.cells["quad"]),
@@ -260,7 +260,7 @@ def format_report(row: dict, header: bool = True) -> list[str]:
                  f" {row['coupled']}")
     phases = [("mesh", "mesh generation"), ("build", "build_model (elements, assembly, T'KT)"),
               ("reduce", "Craig-Bampton reduction"), ("couple", "coupling (4 cam followers)"),
-              ("sweep", f"sweep ({row.get('sweep_angles', N_ANGLES)} angles, vectors)")]
+              ("sweep", f"sweep ({row['sweep_angles']} angles, vectors)")]
     if "check_s" in row:
         phases.append(("check", f"full coupled check ({row['n_check']} angles)"))
     table = [[label, f"{row[f'{key}_s']:.2f}", f"{row[f'{key}_peak_mb']:.0f}"]
@@ -288,7 +288,6 @@ def main(size: str = "large", n_angles: int = N_ANGLES, n_check: int = 0,
          out_file=HERE / "results" / "scale.txt", echo: bool = True) -> dict:
     """Run :func:`run` and print / write the report (``out_file=None``: not written)."""
     row = run(size, n_angles, n_check)
-    row["sweep_angles"] = n_angles
     fmb.publish("\n".join(format_report(row)), out_file, echo)
     return row
 

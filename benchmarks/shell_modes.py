@@ -173,7 +173,6 @@ def main(sizes=("small", "medium", "large"), with_slow_reference=False,
     unknown = [s for s in sizes if s not in SIZES]
     if unknown:
         raise ValueError(f"unknown sizes {unknown}; choose from {list(SIZES)}")
-    fmb._return_freed_memory()
     rows, history = [], []
     for name in sizes:
         rows.append(modes_case(name, with_slow_reference, history))

@@ -46,7 +46,6 @@ from femmech.generators import grid_frame
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from frame_modes import (  # noqa: E402  (sibling benchmark: shared measurement helpers)
     PhaseTimer,
-    _return_freed_memory,
     _table,
     machine_info,
     peak_memory,
@@ -223,7 +222,6 @@ def main(sizes=("20k", "150k"), names=None,
         names.insert(0, "superlu")
     for name in names:
         solvers.resolve(name)
-    _return_freed_memory()
     rows = []
     for case in sizes:
         rows += model_rows(case, names)

@@ -441,9 +441,9 @@ def _block_lanczos(K, M, k, sigma, lu, deflate=None, block=BLOCK_SIZE, tol=LANCZ
                 break
         return W, (m_times(W) if MW is None else MW), C
 
-    work = np.empty((n, block), order="F")  # products V c, updated in place (the loop
-    # allocates few vectors: with glibc serving every array above 128 KiB by mmap, as the
-    # benchmarks set it, temporaries made a 24k-DOF solve 1.8x slower)
+    work = np.empty((n, block), order="F")  # products V c, updated in place: the loop
+    # allocates few vectors (a first touch of fresh memory costs ~1 ms per MB on the
+    # project's VM; temporaries served by mmap made a 24k-DOF solve 1.8x slower)
 
     def orthogonalize_local(W, lo, hi):
         """Two classical Gram-Schmidt passes of W (overwritten) against the last blocks

@@ -21,7 +21,8 @@ and OpenMP runtime (MKL PARDISO and CHOLMOD thread through them).
 from __future__ import annotations
 
 import os
-from contextlib import contextmanager
+import sys
+from contextlib import contextmanager, nullcontext
 from dataclasses import dataclass, replace
 
 from threadpoolctl import ThreadpoolController, threadpool_info
@@ -138,35 +139,37 @@ def _libraries() -> ThreadpoolController:
     :func:`refresh`.
     """
     global _controller, _controller_key
-    import sys
     key = len(sys.modules)
     if _controller is None or key != _controller_key:
         _controller, _controller_key = ThreadpoolController(), key
     return _controller
 
 
-_outside: list = []  # thread counts before each enclosing solve phase (for gemm_phase)
+def _switch(limits):
+    """The libraries on ``limits`` threads in a ``with`` block (None: no change)."""
+    return nullcontext() if limits is None else _libraries().limit(limits=limits)
+
+
+_outside: list = []  # thread counts before each enclosing phase (for gemm_phase)
 
 
 @contextmanager
 def _limited(limits):
+    """:func:`_switch`, remembering the counts from before (:func:`gemm_phase`)."""
     if limits is None:
         yield
         return
-    controller = _libraries()
-    _outside.append(controller.info())
+    _outside.append(_libraries().info())
     try:
-        with controller.limit(limits=limits):
+        with _switch(limits):
             yield
     finally:
         _outside.pop()
 
 
-@contextmanager
 def exactly(n: int):
-    """Every loaded BLAS and OpenMP library on ``n`` threads in the block."""
-    with _libraries().limit(limits=n):
-        yield
+    """Every loaded BLAS and OpenMP library on ``n`` threads in a ``with`` block."""
+    return _switch(n)
 
 
 @contextmanager
@@ -193,12 +196,9 @@ def gemm_phase():
     counts from before the enclosing phase apply (outside any phase: no change).
     """
     limits = _settings.factor
-    if limits is None:
-        limits = _outside[-1] if _outside else None
-    if limits is None:
-        yield
-        return
-    with _libraries().limit(limits=limits):
+    if limits is None and _outside:
+        limits = _outside[-1]
+    with _switch(limits):
         yield
 
 
