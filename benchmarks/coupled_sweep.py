@@ -72,8 +72,43 @@ def arpack_full(full, phi: float, n_modes: int) -> dict:
             "max_rel_diff": float(np.max(np.abs(omega2 - ref) / np.abs(ref)))}
 
 
+def reduction_variant(model, cams, guides, f_max_hz: float, residual_vectors: bool, phi,
+                      check, f_full, n_modes: int) -> dict:
+    """Speed against error of one Craig-Bampton basis for the same machine.
+
+    Reduces ``model`` with fixed-interface modes up to ``f_max_hz`` (with or without
+    residual vectors), couples the cams, times the sweep over ``phi`` with vectors, tracked
+    and untracked (``track=False``: the per-angle solves alone, as the full solve does
+    them; fastest of 3 each), and compares the sorted frequencies at ``check`` with the
+    full model's ``f_full`` (n_check, n_modes), Hz.
+    """
+    from femmech.analysis.sweep import sweep
+    from femmech.coupling import couple
+    from femmech.reduction import craig_bampton
+
+    ex = _example()
+    start = time.perf_counter()
+    se = craig_bampton(model, [(cams, ["rx"]), (guides, ["uz"])], f_max_hz=f_max_hz,
+                       residual_vectors=residual_vectors)
+    reduce_s = time.perf_counter() - start
+    reduced = couple(se, ex.mounts(cams, guides))
+    seconds = {True: [], False: []}
+    for _ in range(3):
+        for track in (True, False):
+            start = time.perf_counter()
+            sweep(reduced, phi, n_modes=n_modes, keep_vectors=True, track=track)
+            seconds[track].append(time.perf_counter() - start)
+    f = np.sort(sweep(reduced, check, n_modes=n_modes, track=False).freq_hz, axis=1)
+    return {"f_max_hz": f_max_hz, "residual_vectors": residual_vectors, "n_reduced": reduced.n,
+            "n_modal": se.n_modal, "reduction_s": reduce_s,
+            "tracked_ms": 1e3 * min(seconds[True]) / phi.size,
+            "untracked_ms": 1e3 * min(seconds[False]) / phi.size,
+            "max_rel_error": float(np.max(np.abs(f / f_full - 1.0)))}
+
+
 def main(n_cams: int = 50, n_angles: int = 360, n_check: int = 8, n_modes: int = 6,
-         per_spacing: int = 8, keep_vectors: bool = False, n_arpack: int = 0) -> dict:
+         per_spacing: int = 8, keep_vectors: bool = False, n_arpack: int = 0,
+         variants=()) -> dict:
     """Run the comparison; return the measured numbers.
 
     ``keep_vectors`` stores the mode shapes in the timed sweep; ``n_check = 0`` skips the
@@ -81,7 +116,9 @@ def main(n_cams: int = 50, n_angles: int = 360, n_check: int = 8, n_modes: int =
     entries are then None). ``per_angle`` holds, per checked angle (rad), the full solve's
     seconds, the largest relative frequency error and the smallest MAC of the n_modes.
     ``n_arpack``: at that many of the checked angles the full problem is also solved by
-    ARPACK (:func:`arpack_full`; list ``arpack``, empty by default).
+    ARPACK (:func:`arpack_full`; list ``arpack``, empty by default). ``variants``: pairs
+    (f_max_hz, residual_vectors) of further Craig-Bampton bases compared at the checked
+    angles (:func:`reduction_variant`; list ``variants``; needs ``n_check > 0``).
     """
     from femmech.analysis.reference import compare_coupled
     from femmech.analysis.sweep import sweep
@@ -101,7 +138,7 @@ def main(n_cams: int = 50, n_angles: int = 360, n_check: int = 8, n_modes: int =
         "keep_vectors": keep_vectors, "sweep_s": t_sweep,
         "sweep_per_angle_ms": 1e3 * t_sweep / n_angles, "full_per_angle_ms": None,
         "max_rel_error": None, "min_mac": None, "speedup": None, "per_angle": None,
-        "arpack": [],
+        "arpack": [], "variants": [],
     }
     if n_check <= 0:
         return out
@@ -115,6 +152,11 @@ def main(n_cams: int = 50, n_angles: int = 360, n_check: int = 8, n_modes: int =
                           "max_rel_error": errors.max(axis=1), "min_mac": macs.min(axis=1)})
     out["speedup"] = out["full_per_angle_ms"] / out["sweep_per_angle_ms"]
     out["arpack"] = [arpack_full(full, angle, n_modes) for angle in check[:n_arpack]]
+    if variants:
+        model, cams, guides = ex.frame_and_shaft(n_cams, per_spacing)  # the same model
+        out["variants"] = [reduction_variant(model, cams, guides, f_max, rv, phi, check,
+                                             comparison.freq_full_hz, n_modes)
+                           for f_max, rv in variants]
     return out
 
 
