@@ -33,7 +33,8 @@ def test_solver_benchmark_runs_every_installed_backend(bench, tmp_path):
         assert r["ratio"] > 0
         assert r["ratio_nocheck"] > 0
         # block Lanczos solved at least one vector per mode
-        assert r["vectors_solved"] >= bench.N_MODES and r["solves"] >= 1
+        assert r["vectors_solved"] >= bench.N_MODES
+        assert r["solves"] >= 1
         # >= 20 modes, all confirmed by the Sturm count of this backend's inertia
         assert r["n_modes"] >= bench.N_MODES
         assert r["sturm_count"] == r["n_modes"]
@@ -43,7 +44,8 @@ def test_solver_benchmark_runs_every_installed_backend(bench, tmp_path):
         assert r["max_freq_diff"] < 1e-10
         # the side-by-side ARPACK reference (scipy eigsh on the same factor): an independent
         # eigensolver agrees with femmech's to round-off (measured 4e-13 on this frame)
-        assert r["arpack_solves"] >= bench.N_MODES and r["ratio_arpack"] > 0
+        assert r["arpack_solves"] >= bench.N_MODES
+        assert r["ratio_arpack"] > 0
         assert r["arpack_max_diff"] < 1e-10
     text = out.read_text()
     for heading in ("Full 20-mode eigen solve", "reference algorithm: scipy eigsh",
