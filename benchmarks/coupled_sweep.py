@@ -41,9 +41,8 @@ def arpack_full(full, phi: float, n_modes: int) -> dict:
     and one thread in its loop; its time includes that factorisation. Returns seconds of
     both, ARPACK's solves and the largest relative difference of their eigenvalues.
     """
-    import scipy.sparse.linalg as spla
+    from frame_modes import counted_eigsh  # sibling benchmark (run.py loads it first)
 
-    from femmech import threads
     from femmech.linalg import factorize, solve_symmetric
 
     M, _, C, _ = full.matrices(phi)
@@ -51,23 +50,13 @@ def arpack_full(full, phi: float, n_modes: int) -> dict:
     start = time.perf_counter()
     result = solve_symmetric(C, M, n_modes=n_modes)
     femmech_s = time.perf_counter() - start
-    n = C.shape[0]
     start = time.perf_counter()
     factor = factorize((C - result.sigma * M).tocsc(), solver=result.solver)
-    count = [0]
-
-    def solve(x):
-        count[0] += 1
-        return factor.solve(x)
-
-    op = spla.LinearOperator((n, n), matvec=solve, dtype=float)
-    with threads.solve_phase():
-        omega2 = np.sort(spla.eigsh(C, k=n_modes, M=M, sigma=result.sigma, which="LM",
-                                    OPinv=op, v0=np.ones(n), tol=0,
-                                    return_eigenvectors=False))
+    omega2, solves = counted_eigsh(C, M, n_modes, result.sigma, factor,
+                                   return_eigenvectors=False)
     arpack_s = time.perf_counter() - start
     ref = result.omega2[:n_modes]
-    return {"phi": phi, "femmech_s": femmech_s, "arpack_s": arpack_s, "arpack_solves": count[0],
+    return {"phi": phi, "femmech_s": femmech_s, "arpack_s": arpack_s, "arpack_solves": solves,
             "solver": result.solver, "sigma": result.sigma,
             "max_rel_diff": float(np.max(np.abs(omega2 - ref) / np.abs(ref)))}
 

@@ -52,6 +52,7 @@ import scipy.sparse.linalg as spla
 import femmech as fm
 import femmech.linalg
 import femmech.model
+import femmech.threads
 from femmech import sections
 from femmech.dofs import element_dofs
 from femmech.elements.beam import beam_matrices
@@ -271,6 +272,29 @@ def reference_frequencies(model, sigma, solver):
         omega2 = np.sort(spla.eigsh(K.tocsc(), N_MODES, M.tocsc(), sigma=sigma, which="LM",
                                     v0=v0, return_eigenvectors=False))
     return omega2, time.perf_counter() - start
+
+
+def counted_eigsh(K, M, k: int, sigma: float, factor, return_eigenvectors: bool = True):
+    """scipy's ``eigsh`` (ARPACK), shift-invert at ``sigma`` (rad²/s²) with ``factor`` (a
+    factorisation of ``K - σM`` with ``solve``) as ``OPinv``, tol = 0, a start vector of
+    ones and one thread in its loop: the issue-10 reference algorithm on a given factor.
+
+    Returns the ``k`` eigenvalues ω² (rad²/s², ascending) and the number of solves ARPACK
+    made. ``return_eigenvectors`` is passed to ``eigsh``.
+    """
+    n = K.shape[0]
+    count = [0]
+
+    def solve(x):
+        count[0] += 1
+        return factor.solve(x)
+
+    op = spla.LinearOperator((n, n), matvec=solve, dtype=float)
+    with femmech.threads.solve_phase():
+        result = spla.eigsh(K, k=k, M=M, sigma=sigma, which="LM", OPinv=op, v0=np.ones(n),
+                            tol=0, return_eigenvectors=return_eigenvectors)
+    omega2 = result[0] if return_eigenvectors else result
+    return np.sort(omega2), count[0]
 
 
 def frequency_error(omega2, omega2_ref, scale):

@@ -41,7 +41,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
 import femmech as fm
 import femmech.linalg
@@ -52,6 +51,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from frame_modes import (  # noqa: E402  (sibling benchmark: shared measurement helpers)
     PhaseTimer,
     _table,
+    counted_eigsh,
     machine_info,
     peak_memory,
     publish,
@@ -165,20 +165,10 @@ def arpack_solve(model, name, sigma):
     """(seconds, solves, ω²) of scipy's ``eigsh`` for N_MODES pairs near σ, shift-invert
     with this backend's factor of ``K - σM`` (factorisation included), tol = 0."""
     K, M = model.K_free, model.M_free
-    n = K.shape[0]
     start = time.perf_counter()
     factor = solvers.factorize((K - sigma * M).tocsc(), name, definite=True)
-    count = [0]
-
-    def solve(x):
-        count[0] += 1
-        return factor.solve(x)
-
-    op = spla.LinearOperator((n, n), matvec=solve, dtype=float)
-    with threads.solve_phase():
-        omega2, _ = spla.eigsh(K, k=N_MODES, M=M, sigma=sigma, which="LM", OPinv=op,
-                               v0=np.ones(n), tol=0)
-    return time.perf_counter() - start, count[0], np.sort(omega2)
+    omega2, solves = counted_eigsh(K, M, N_MODES, sigma, factor)
+    return time.perf_counter() - start, solves, omega2
 
 
 def model_rows(case, names):
