@@ -149,3 +149,7 @@ def test_bad_arguments_are_named(suite, tmp_path):
         suite.main("huge", out_dir=None, echo=False)
     with pytest.raises(ValueError, match="unknown benchmarks"):
         suite.main("tiny", only=["nope"], out_dir=None, echo=False)
+    # basis variants are judged against the full solves: without checked angles, say so
+    with pytest.raises(ValueError, match="variants need n_check > 0"):
+        suite.coupled_sweep.main(n_cams=4, n_angles=12, n_check=0, per_spacing=2,
+                                 variants=((400.0, True),))
