@@ -598,12 +598,9 @@ class PardisoFactor(Factor):
         return df, self.perm.astype(np.int64)  # df is in elimination order (iparm(5) = 2)
 
     def refactor(self, A):
-        U = _upper_csr(A)
-        if U.shape[0] != self.n:
-            raise ValueError(f"refactor: matrix of order {U.shape[0]}, factor of order {self.n}")
+        U = _upper_csr(self._same_order(A, "refactor"))
         ia, ja = self._pattern
-        if not (np.array_equal(U.indptr, ia)
-                                        and np.array_equal(U.indices, ja)):
+        if not (np.array_equal(U.indptr, ia) and np.array_equal(U.indices, ja)):
             raise ValueError("refactor: the sparsity pattern differs from the analysed one;"
                              " call factorize for a new pattern")
         try:
