@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import sympy
 from numpy.testing import assert_allclose
+from roundoff import EPS, largest_eigenvalue
 
 import femmech as fm
 from femmech import sections
@@ -79,12 +80,19 @@ def machine(units: str, subdivisions: int):
 
 
 # Round-off: each system computes with its own rounding of the same numbers (relative
-# eps per entry); frequencies differ by ~eps times condition. Measured in frequency:
-# full 1.8e-13 (dense) and 1.5e-12 (ARPACK), reduced 2.3e-13 / 7.4e-13, coupled sweep
-# 2.1e-13 / 5.6e-13. Before this issue the reduced models differed by 1.1e-4: the
-# residual vectors' drop test of craig_bampton summed M-norms of translational and
-# rotational columns (36 vectors kept in m-kg-s, 26 in mm-t-s).
-UNITS_RTOL = 1e-10
+# eps per entry); eigenvalues differ by ~eps λ_max absolute (tests/roundoff.py), so
+# frequencies by ~eps λ_max / (2 λ_1) relative at most, the full model's scale bounding the
+# reduced and coupled ones (Ritz values lie inside the full spectrum): units_rtol, 3.5e-10
+# (2 subdivisions) and 1.5e-9 (4; the former fixed 1e-10 lay below both). Measured in
+# frequency: full 1.8e-13 (dense) and 1.5e-12 (ARPACK), reduced 2.3e-13 / 7.4e-13,
+# coupled sweep 2.1e-13 / 5.6e-13. Before this issue the reduced models differed by
+# 1.1e-4: the residual vectors' drop test of craig_bampton summed M-norms of translational
+# and rotational columns (36 vectors kept in m-kg-s, 26 in mm-t-s).
+
+
+def units_rtol(model, full) -> float:
+    """Relative frequency round-off, 10 eps λ_max / (2 λ_1), of the SI model."""
+    return 5 * EPS * largest_eigenvalue(model.K_free, model.M_free) / full.omega2[0]
 
 
 @pytest.mark.parametrize(("subdivisions", "method"), [(2, "dense"), (4, "arpack")])
@@ -94,21 +102,23 @@ def test_same_machine_in_two_unit_systems(subdivisions, method):
     and changes results with the units; ARPACK started from the same random vector in
     differently scaled coordinates must still converge to the same pairs. femmech's
     shifts and thresholds are relative to the pencil's own scale."""
-    results = {}
+    results, models = {}, {}
     for units in UNITS:
         model, se, system = machine(units, subdivisions)
+        models[units] = model
         full = fm.modes(model, n_modes=12)
         assert full.method == method
         reduced = superelement_modes(se, n_modes=12)
         coupled = sweep(system, np.linspace(0.0, 2 * np.pi, 13), n_modes=8)
         results[units] = (full, reduced, coupled)
     (f1, r1, c1), (f2, r2, c2) = results.values()
-    assert_allclose(f2.freq_hz, f1.freq_hz, rtol=UNITS_RTOL)
+    rtol = units_rtol(models["m-kg-s"], f1)
+    assert_allclose(f2.freq_hz, f1.freq_hz, rtol=rtol)
     assert f2.sturm_count == f1.sturm_count
     assert f1.residual.max() < 1e-8
     assert f2.residual.max() < 1e-8
-    assert_allclose(r2.freq_hz, r1.freq_hz, rtol=UNITS_RTOL)
-    assert_allclose(c2.freq_hz, c1.freq_hz, rtol=UNITS_RTOL)
+    assert_allclose(r2.freq_hz, r1.freq_hz, rtol=rtol)
+    assert_allclose(c2.freq_hz, c1.freq_hz, rtol=rtol)
     assert_allclose(c2.mac_step, c1.mac_step, atol=1e-9)  # same branches: measured 5e-14
     # mode shapes: u_mm = D u_SI (D: 1e3 on translations, 1 on rotations) and
     # M_mm = Mu L² D⁻¹ M_SI D⁻¹, so mass-normalised shapes map as φ_SI = L √Mu D⁻¹ φ_mm
