@@ -6,7 +6,7 @@ Importing femmech has no side effects and does not import pyvista (see
 
 from femmech.analysis.modes import ModeSet, modes
 from femmech.constraints import InterpolatingLink, RigidLink, Support
-from femmech.errors import FemmechWarning
+from femmech.errors import ConvergenceWarning, FemmechWarning, ModelWarning
 from femmech.io import read_mesh
 from femmech.lumped import PointMass, Spring
 from femmech.materials import Material
@@ -28,10 +28,12 @@ __all__ = [
     "BeamProperty",
     "BeamSection",
     "FEModel",
+    "ConvergenceWarning",
     "FemmechWarning",
     "InterpolatingLink",
     "Material",
     "Mesh",
+    "ModelWarning",
     "ModeSet",
     "PointMass",
     "RigidLink",

@@ -1,7 +1,9 @@
 """Command line: ``femmech run SCENE --out DIR`` and ``femmech check SCENE``.
 
 Exit codes: 0 success, 1 a computation failed, 2 an invalid scene or command line (the
-error is one line on stderr naming the file, the key and what was expected).
+error is one line on stderr naming the file, the key and what was expected). Suspicious
+inputs (nearly coincident nodes, loose parts, unit mix-ups: :mod:`femmech.checks`) are
+reported, not refused: one ``warning:`` line each on stdout and in the run's log.
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ def _parser() -> argparse.ArgumentParser:
 
 def _check(path: Path) -> int:
     from femmech.scene import load_scene
-    from femmech.scene_build import prepare
+    from femmech.scene_build import finding_lines, prepare
 
     prepared = prepare(load_scene(path))
     scene = prepared.scene
@@ -44,6 +46,8 @@ def _check(path: Path) -> int:
                 if getattr(scene.analyses, k) is not None]
     print(f"{path.name}: OK: parts {parts or '-'}; mechanisms {list(scene.mechanisms) or '-'};"
           f" mounts {len(scene.mounts)}; analyses {analyses}")
+    for line in finding_lines(prepared):  # suspicious inputs: reported, not refused
+        print(f"{path.name}: {line}")
     return 0
 
 

@@ -26,6 +26,13 @@ MAX_DEFLATIONS = 10
 DENSE_BELOW = 400
 """Systems with fewer DOFs than this are solved with dense LAPACK (``scipy.linalg.eigh``)."""
 
+RIGID_TOL = 1e-12
+"""Eigenvalues with ``|ω²| <= RIGID_TOL * scale`` are rigid-body modes (scale: a typical
+element eigenvalue, e.g. :func:`femmech.analysis.modes.model_eigenvalue_scale`). Computed
+rigid-body eigenvalues are ~1e-17 of the scale, of either sign (also on free shells at
+span/thickness 1e4, whose lowest elastic eigenvalue is 3e-10 of it); elastic modes of
+1e-12 of the scale are ~1e-6 of the typical element frequency."""
+
 
 @dataclass(frozen=True)
 class EigenResult:
@@ -152,6 +159,28 @@ def residuals(K, M, omega2, vectors, floor: float) -> np.ndarray:
     num = np.linalg.norm(Kx - Mx * omega2, axis=0)
     den = np.maximum(np.abs(omega2), floor) * np.linalg.norm(Mx, axis=0)
     return num / np.where(den > 0, den, 1.0)
+
+
+RESIDUAL_TOL = 1e-6
+"""Relative residual above which a computed mode is reported (when round-off allows it)."""
+
+
+def residual_limits(K, M, omega2, vectors, floor: float) -> np.ndarray:
+    """Per column, the larger of :data:`RESIDUAL_TOL` and the round-off level of a residual.
+
+    Forming ``K x`` alone carries an error of about eps ‖K‖∞ ‖x‖ (Higham, Accuracy and
+    Stability of Numerical Algorithms, 2002, sect. 3.5), so the relative residual of
+    :func:`residuals` can not fall below ~eps ‖K‖∞ ‖x‖ / (max(|λ|, floor) ‖M x‖) on any
+    BLAS; 100 times that is the limit (the low modes of stiff-contrast pencils and fine
+    slender-beam meshes, eps λ_max / λ_1 ~ 1e-7 … 1e-4, whose residuals otherwise cross
+    a fixed 1e-6 on one BLAS kernel and not on another).
+    """
+    k_norm = float(abs(K).sum(axis=1).max()) if K.shape[0] else 0.0
+    x_norm = np.linalg.norm(vectors, axis=0)
+    mx_norm = np.linalg.norm(M @ vectors, axis=0)
+    den = np.maximum(np.abs(omega2), floor) * mx_norm
+    roundoff = 100 * np.finfo(float).eps * k_norm * x_norm / np.where(den > 0, den, np.inf)
+    return np.maximum(RESIDUAL_TOL, roundoff)
 
 
 def _complete_cluster(omega2: np.ndarray, n_wanted: int, rtol: float = 1e-6) -> int:
@@ -696,7 +725,8 @@ def _check_request(n, n_mass, n_modes, band, sigma, factor, scale):
 
 def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] | None = None,
                     sigma: float | None = None, dense_below: int = DENSE_BELOW,
-                    check: bool = True, factor=None, scale: float | None = None) -> EigenResult:
+                    check: bool = True, factor=None, scale: float | None = None,
+                    rigid_tol: float | None = None) -> EigenResult:
     """Lowest eigenpairs, or all eigenpairs in a band, of ``K x = λ M x``.
 
     Parameters
@@ -707,7 +737,11 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         Number of lowest eigenpairs. If the n-th eigenvalue is repeated, the whole
         cluster is returned, so a degenerate subspace is never cut.
     band : (float, float), optional
-        ``(λ_lo, λ_hi)`` in rad²/s²; all eigenpairs with ``λ_lo <= λ <= λ_hi``.
+        ``(λ_lo, λ_hi)`` in rad²/s²; all eigenpairs with ``λ_lo <= λ <= λ_hi``. A band
+        from ``λ_lo <= rigid_tol`` (e.g. 0) holds every rigid-body mode, also those whose
+        computed λ is round-off below zero: it returns all eigenpairs up to
+        ``max(λ_hi, rigid_tol)`` (K is positive semi-definite), on the sparse path by the
+        lowest-modes search with a shift below zero (no factorisation of a singular K).
     sigma : float, optional
         Shift; default :func:`default_shift` (n_modes) or the band centre (band).
     dense_below : int
@@ -725,6 +759,9 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         the floor of the relative residuals and the Sturm cut; default
         :func:`eigenvalue_scale`. Give it when the diagonal of K does not show it, e.g.
         a K that is round-off only (a rigid body assembled from stiff elements).
+    rigid_tol : float, optional
+        Eigenvalues with ``|λ| <= rigid_tol`` (rad²/s²) are zero (rigid-body modes);
+        default ``RIGID_TOL * scale`` (:data:`RIGID_TOL`).
 
     Returns
     -------
@@ -740,6 +777,10 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
     _check_request(n, _n_mass(M), n_modes, band, sigma, factor, scale)
     scale = eigenvalue_scale(K, M) if scale is None else float(scale)
     shift = -1e-6 * scale if sigma is None else float(sigma)
+    zero = RIGID_TOL * scale if rigid_tol is None else float(rigid_tol)
+    if band is not None and band[0] <= zero:  # from 0: rigid modes of ω² ~ -eps too
+        band = (-np.inf, max(float(band[1]), zero))
+    count, cut = None, None
     if n < dense_below:
         wanted = None if band is not None else n_modes + max(4, n_modes // 5)
         omega2, X = dense_symmetric(K, M, wanted, sigma=shift)
@@ -752,15 +793,22 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         omega2, X, count, cut, shift = _sparse_lowest(K, M, n_modes, shift, factor, check,
                                                       scale, movable=sigma is None)
         method = "arpack"
+    elif band[0] == -np.inf and (sigma is None or factor is None and sigma < 0):
+        omega2, X, count, cut, shift = _sparse_from_zero(K, M, band[1], shift, check, scale,
+                                                         movable=sigma is None)
+        method = "arpack"
     else:
         omega2, X, shift = _sparse_band(K, M, band, sigma, factor)
         method = "arpack"
     X = normalize_modes(X, M)
     res = residuals(K, M, omega2, X, 1e-6 * scale)
-    if res.size and res.max() > 1e-6:
-        warnings.warn(f"eigen solve: largest relative residual {res.max():.2e} exceeds 1e-6",
+    limits = residual_limits(K, M, omega2, X, 1e-6 * scale)
+    if res.size and (res > limits).any():
+        k = int(np.argmax(res / limits))
+        warnings.warn(f"eigen solve: relative residual {res[k]:.2e} of mode {k + 1} exceeds"
+                      f" {limits[k]:.1e} (1e-6, or 100 times its round-off level)",
                       FemmechWarning, stacklevel=2)
-    if method == "dense" or n_modes is None:
+    if method == "dense":
         count, cut = None, None
     solver = None if method == "dense" else (
         solvers.resolve(None, n) if factor is None else getattr(factor, "name", "user"))
@@ -836,6 +884,31 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
         count = _complete_cluster(omega2, min(n_modes, omega2.size))
     raise RuntimeError(f"Sturm check: eigenvalues below {cut:.6g} rad²/s² still missing after"
                        f" {MAX_DEFLATIONS} deflated restarts; try another sigma")
+
+
+def _sparse_from_zero(K, M, hi, sigma, check, scale, movable):
+    """All eigenpairs with ``λ <= hi`` of a positive semi-definite pencil (a band from 0).
+
+    The Sturm count below ``hi`` gives their number n; they are the n lowest, found by
+    :func:`_sparse_lowest` with the shift σ < 0 of the lowest-modes path, so that a
+    singular K (rigid-body modes, computed λ of either sign) is never factorised, and
+    Sturm-checked there (the count reuses the ordering of the factorisation of
+    ``K - σM``). Returns ``omega2, X, sturm_count, cut, sigma``.
+    """
+    lu = factorize(K - sigma * M, definite=None if sigma < 0 else False)
+    n_below = inertia_below(K, M, hi, like=lu)
+    if n_below is None:
+        raise RuntimeError("band search needs a Sturm count, which failed for this pencil;"
+                           " ask for n_modes instead")
+    if n_below == 0:
+        return np.empty(0), np.empty((K.shape[0], 0)), 0, hi, sigma
+    omega2, X, count, cut, sigma = _sparse_lowest(K, M, n_below, sigma, lu, check, scale,
+                                                  movable=movable)
+    keep = omega2 <= hi
+    if np.count_nonzero(keep) != n_below:
+        raise RuntimeError(f"band search found {np.count_nonzero(keep)} of {n_below}"
+                           f" eigenvalues (Sturm count) below {hi:.6g} rad²/s²")
+    return omega2[keep], X[:, keep], count, cut, sigma
 
 
 def _sparse_band(K, M, band, sigma, factor=None):

@@ -6,6 +6,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
 
 NODES_PER_CELL = {
     "vertex": 1, "line": 2, "line3": 3, "triangle": 3, "quad": 4, "triangle6": 6,
@@ -106,6 +109,43 @@ class Mesh:
                    {name: {"line": idx} for name, idx in cell_sets.items()},
                    dict(node_sets or {}))
 
+    def merge_nodes(self, tol: float, keep=()) -> Mesh:
+        """Mesh with the nodes closer than ``tol`` merged (cells and groups renumbered).
+
+        Nodes within ``tol`` of each other, directly or through a chain, become one node,
+        which keeps the lowest index and coordinates of its cluster; the other nodes are
+        removed and the rest renumbered in order (:func:`merged_node_index` gives the new
+        index of each old node). Node sets are remapped; cell sets are unchanged.
+
+        Parameters
+        ----------
+        tol : float
+            Distance, m (e.g. 1e-6 × the model size).
+        keep : array_like of int
+            Nodes never merged, e.g. the two ends of a zero-length spring.
+
+        Raises
+        ------
+        ValueError
+            If a cell would lose a node (two of its nodes closer than ``tol``), naming it.
+        """
+        new = merged_node_index(self.points, tol, keep)
+        cells = {}
+        for kind, c in self.cells.items():
+            c = new[c]
+            ordered = np.sort(c, axis=1)
+            bad = np.flatnonzero((ordered[:, 1:] == ordered[:, :-1]).any(axis=1))
+            if bad.size:
+                e = int(bad[0])
+                raise ValueError(f"merge_nodes({tol:g}): {kind} cell {e} (nodes"
+                                 f" {self.cells[kind][e].tolist()}) would collapse: two of its"
+                                 f" nodes are closer than {tol:g} m ({bad.size} such cells);"
+                                 " use a smaller tolerance")
+            cells[kind] = c
+        first = np.unique(new, return_index=True)[1]
+        node_sets = {name: np.unique(new[nodes]) for name, nodes in self.node_sets.items()}
+        return Mesh(self.points[first], cells, self.cell_sets, node_sets)
+
     def group_names(self) -> list[str]:
         """All cell-set and node-set names."""
         return sorted(set(self.cell_sets) | set(self.node_sets))
@@ -118,6 +158,35 @@ class Mesh:
             parts = [self.cells[kind][idx].ravel() for kind, idx in self.cell_sets[name].items()]
             return np.unique(np.concatenate(parts)) if parts else np.empty(0, dtype=np.int64)
         raise ValueError(f"unknown group {name!r}; the mesh has {self.group_names()}")
+
+
+def merged_node_index(points: np.ndarray, tol: float, keep=()) -> np.ndarray:
+    """New index of each node when nodes closer than ``tol`` are merged.
+
+    Clusters are the connected components of the pairs closer than ``tol`` (m; nodes in
+    ``keep`` take part in none); each cluster becomes the node of its lowest index, and
+    the new indices number the clusters in that order.
+
+    Returns
+    -------
+    ndarray (n_nodes,) of int
+        ``new[i]``: index of old node i in the merged mesh.
+    """
+    if not (np.isfinite(tol) and tol >= 0):
+        raise ValueError(f"merge tolerance must be a distance >= 0 (m), got {tol}")
+    n = len(points)
+    pairs = cKDTree(points).query_pairs(tol, output_type="ndarray") if n > 1 else \
+        np.empty((0, 2), dtype=np.int64)
+    kept = np.zeros(n, dtype=bool)
+    kept[_indices(keep, "merge_nodes keep")] = True
+    pairs = pairs[~kept[pairs].any(axis=1)] if len(pairs) else pairs
+    graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    first = np.full(label.max(initial=-1) + 1, n)
+    np.minimum.at(first, label, np.arange(n))  # lowest node of each cluster
+    rank = np.empty_like(first)
+    rank[np.argsort(first)] = np.arange(first.size)
+    return rank[label]
 
 
 def _real_array(value, label: str) -> np.ndarray:

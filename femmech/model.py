@@ -14,6 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
+from femmech import checks
 from femmech.assembly import assemble
 from femmech.constraints import (
     EquationSet,
@@ -174,7 +175,8 @@ class FEModel:
 def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses=(),
                 springs=(), supports=(), rigid_links=(), interpolating_links=(),
                 shells: dict[str, ShellProperty] | None = None,
-                solids: dict[str, SolidProperty] | None = None) -> FEModel:
+                solids: dict[str, SolidProperty] | None = None,
+                node_tol: float | None = None) -> FEModel:
     """Assemble an :class:`FEModel`.
 
     Parameters
@@ -199,6 +201,9 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
         cell needs exactly one. A node shared with a beam or shell couples translations
         only; join a beam end to a patch of solid nodes with a rigid or interpolating
         link to transmit moments (:mod:`femmech.parts`).
+    node_tol : float, optional
+        Distance (m) below which two nodes that nothing joins are reported as nearly
+        coincident; default :data:`femmech.checks.NEAR_NODE_TOL` times the model size.
 
     Raises
     ------
@@ -206,6 +211,12 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
         Naming the offending element, node or group: unknown group names, elements
         without or with two properties, unused nodes, coincident nodes that no spring or
         rigid link joins, zero-length elements, orientation vectors along an element.
+
+    Warns
+    -----
+    ModelWarning
+        For each finding of :func:`model_findings` (nearly coincident nodes, loose parts,
+        unit mix-ups), naming the nodes, groups and values.
     """
     beams = {} if beams is None else beams
     shells = {} if shells is None else shells
@@ -267,6 +278,8 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
     T, free = constraint_transform(n_dof, fixed | inactive, eqs)
     Tt = T.T.tocsr()
     links = np.array(joined, dtype=np.int64).reshape(-1, 2)
+    checks.warn(model_findings(mesh, beams, masses, springs, supports, rigid_links,
+                               interpolating_links, shells, solids, node_tol=node_tol))
     return FEModel(mesh, K, M, T, free, beam_set, np.array(mass_nodes, dtype=np.int64), links,
                    (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr(), shell_set, solid_set,
                    np.flatnonzero(inactive))
@@ -446,3 +459,53 @@ def _check_nodes(mesh: Mesh, used: np.ndarray, joined) -> None:
             if (min(a, b), max(a, b)) not in ok:
                 raise ValueError(f"nodes {a} and {b} coincide at {mesh.points[a].tolist()} but no"
                                  " spring or rigid link joins them; merge them (duplicate nodes)")
+
+
+def model_findings(mesh: Mesh, beams=None, masses=(), springs=(), supports=(), rigid_links=(),
+                   interpolating_links=(), shells=None, solids=None, anchors=(),
+                   node_tol: float | None = None) -> tuple[checks.Finding, ...]:
+    """Suspicious inputs of :func:`build_model` (same arguments), without assembly.
+
+    Nearly coincident nodes that nothing joins, pieces that are free bodies by accident
+    and unit mix-ups (:mod:`femmech.checks`). ``anchors``: further nodes held from
+    outside the model (group names or node indices, e.g. the attachments of mechanisms),
+    so that a piece holding one is not reported as loose. References are resolved as in
+    :func:`build_model` (ValueError naming the item when one does not exist).
+    """
+    beams, shells, solids = beams or {}, shells or {}, solids or {}
+    joined, held = [], [node_indices(mesh, a, "anchor") for a in anchors]
+    held += [node_indices(mesh, s.nodes, "support") for s in supports]
+    for item in springs:
+        a = node_index(mesh, item.node_a, "spring")
+        if item.node_b is None:
+            held.append(np.array([a]))
+        else:
+            joined.append((a, node_index(mesh, item.node_b, "spring")))
+    masters, slaves, _ = _rigid_pairs(mesh, rigid_links)
+    joined += zip(masters.tolist(), slaves.tolist(), strict=True)
+    joined += [(r, q) for r, p, _, _ in _spider_nodes(mesh, interpolating_links) for q in p]
+    points = mesh.points
+    materials, sections, element_mass = {}, [], 0.0
+    for props, kinds in ((beams, ("line",)), (shells, SHELL_TYPES), (solids, SOLID_TYPES)):
+        for group, prop in props.items():
+            m = prop.material
+            key = m.name if materials.get(m.name, (m.E, m.rho)) == (m.E, m.rho) \
+                else f"{m.name} ({group})"
+            materials[key] = (m.E, m.rho)
+            per_area = prop.section.A if props is beams else \
+                (prop.thickness if props is shells else 1.0)
+            for kind, idx in mesh.cell_sets.get(group, {}).items():
+                if kind in kinds and len(idx):
+                    cells = mesh.cells[kind][idx]
+                    element_mass += m.rho * per_area * float(
+                        checks.cell_measure(points, kind, cells).sum())
+                    if props is beams:
+                        span = float(np.linalg.norm(np.ptp(points[cells.ravel()], axis=0)))
+                        sections.append((group, 2.0 * prop.section.draw_radius, span))
+    masses = [(node_index(mesh, m.node, "point mass"), float(m.mass)) for m in masses]
+    cells = {k: c for k, c in mesh.cells.items() if k != "vertex"}
+    extent = float(np.linalg.norm(np.ptp(points, axis=0)))
+    held = np.concatenate(held) if held else np.empty(0, dtype=np.int64)
+    return tuple(checks.near_node_findings(points, cells, joined, node_tol)
+                 + checks.loose_parts(mesh.n_nodes, cells, joined, held)
+                 + checks.unit_findings(extent, materials, sections, masses, element_mass))

@@ -97,13 +97,15 @@ class SolidSpec:
 
 @dataclass(frozen=True)
 class MeshSpec:
-    """A mesh file (absolute path) or a generator with its parameters (SI)."""
+    """A mesh file (absolute path) or a generator with its parameters (SI); nodes closer
+    than ``merge_tol`` (m) are merged (:meth:`femmech.Mesh.merge_nodes`)."""
 
     file: str | None = None
     generator: str | None = None
     params: dict = field(default_factory=dict)
     edge_node_groups: tuple = ()
     where: str = field(default="", compare=False)
+    merge_tol: float | None = None
 
 
 @dataclass(frozen=True)
@@ -260,11 +262,12 @@ def _mesh(r: Reader, base: Path) -> MeshSpec:
     if r.has("mesh") == r.has("generator"):
         raise r.error(None, "give exactly one of mesh (a file) and generator (a table)")
     edges = r.strings("edge_node_groups", ())
+    merge = r.number("merge_nodes", LENGTH, None, positive=True)
     if r.has("mesh"):
         file = base / r.string("mesh")
         if not file.is_file():
             raise r.error("mesh", f"file not found: {file}")
-        return MeshSpec(str(file), None, {}, edges, r.where)
+        return MeshSpec(str(file), None, {}, edges, r.where, merge)
     g = r.child("generator", r.get("generator"))
     kind = g.string("kind", choices=GENERATORS)
     if kind == "grid_frame":
@@ -280,7 +283,7 @@ def _mesh(r: Reader, base: Path) -> MeshSpec:
     else:
         params = _members(g)
     g.finish()
-    return MeshSpec(None, kind, params, edges, g.where)
+    return MeshSpec(None, kind, params, edges, g.where, merge)
 
 
 def _members(g: Reader) -> dict:

@@ -2,10 +2,11 @@
 superelements, mechanism models and mounts.
 
 :func:`prepare` does everything that needs no FE computation (reads or generates the
-meshes, builds the mechanism models, checks every group name, node index and
-coordinate name) and is what ``femmech check`` runs; :func:`part_model`,
-:func:`reduce_part` and :func:`machine_mounts` are the computing steps that
-:mod:`femmech.scene_run` calls only when an analysis needs them. Errors of the API
+meshes, merges nearly coincident nodes where the scene asks, builds the mechanism models,
+checks every group name, node index and coordinate name, and collects the suspicious
+inputs of each part, :mod:`femmech.checks`) and is what ``femmech check`` runs;
+:func:`part_model`, :func:`reduce_part` and :func:`machine_mounts` are the computing
+steps that :mod:`femmech.scene_run` calls only when an analysis needs them. Errors of the API
 raised here are re-raised as one-line :class:`~femmech.errors.SceneError` naming the
 scene location.
 """
@@ -15,7 +16,8 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-from dataclasses import dataclass
+import warnings
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -24,9 +26,9 @@ import femmech as fm
 from femmech import sections as sec
 from femmech.coupling import Attachment, Mount
 from femmech.dofs import COMPONENTS
-from femmech.errors import SceneError
+from femmech.errors import ModelWarning, SceneError
 from femmech.generators import grid_frame, members_frame
-from femmech.model import node_index, node_indices
+from femmech.model import model_findings, node_index, node_indices
 from femmech.reduction import FORMAT_VERSION, craig_bampton, guyan
 from femmech.scene import PartSpec, Scene
 
@@ -48,12 +50,15 @@ class Prepared:
     keys : dict[str, str]
         Per part with a reduction: SHA-256 of everything its reduction depends on (see
         :func:`reduction_key_data`).
+    findings : dict[str, tuple of femmech.checks.Finding]
+        Per part: suspicious inputs (:func:`part_findings`).
     """
 
     scene: Scene
     meshes: dict
     mechanisms: dict
     keys: dict
+    findings: dict = field(default_factory=dict)
 
 
 def fail(scene: Scene, where: str, key: str | None, message: str) -> SceneError:
@@ -75,7 +80,15 @@ def prepare(scene: Scene) -> Prepared:
     _check_outputs(scene, models)
     keys = {name: sha256_key(reduction_key_data(scene, part))
             for name, part in scene.parts.items() if part.reduction is not None}
-    return Prepared(scene, meshes, models, keys)
+    findings = {name: part_findings(scene, part, meshes[name])
+                for name, part in scene.parts.items()}
+    return Prepared(scene, meshes, models, keys, findings)
+
+
+def finding_lines(prepared: Prepared) -> list[str]:
+    """One line ``warning: [parts.<name>] kind: message`` per finding of each part."""
+    return [f"warning: [{prepared.scene.parts[name].where}] {f.kind}: {f.message}"
+            for name, found in prepared.findings.items() for f in found]
 
 
 def part_mesh(scene: Scene, part: PartSpec) -> fm.Mesh:
@@ -88,10 +101,50 @@ def part_mesh(scene: Scene, part: PartSpec) -> fm.Mesh:
             mesh = grid_frame(**spec.params)
         else:
             mesh = members_frame(**spec.params)
-        return edges_to_node_sets(mesh, spec.edge_node_groups)
+        mesh = edges_to_node_sets(mesh, spec.edge_node_groups)
     except (ValueError, FileNotFoundError) as exc:
         key = "mesh" if spec.file is not None else None
         raise fail(scene, spec.where, key, str(exc)) from None
+    return mesh if spec.merge_tol is None else merged_mesh(scene, part, mesh)
+
+
+def merged_mesh(scene: Scene, part: PartSpec, mesh: fm.Mesh) -> fm.Mesh:
+    """The part's mesh with the nodes closer than ``merge_nodes`` merged.
+
+    Node indices change by merging, so every node of the part (items, interface, mount
+    attachments, response DOFs) must be given by group name (SceneError otherwise). The
+    two nodes of a spring between nodes are never merged (they may coincide on purpose).
+    """
+    for where, key, ref in _node_refs(scene, part):
+        if not isinstance(ref, str):
+            raise fail(scene, part.where, "merge_nodes", f"node indices change when nodes"
+                       f" are merged; give the nodes by group name, not {ref!r} ([{where}]"
+                       f" {key})")
+    keep = [_resolve(scene, mesh, item.values[key], item.where, key, one=True)
+            for item in part.items if item.kind == "spring"
+            and item.values.get("node_b") is not None for key in ("node_a", "node_b")]
+    try:
+        return mesh.merge_nodes(part.mesh.merge_tol, keep)
+    except ValueError as exc:
+        raise fail(scene, part.where, "merge_nodes", str(exc)) from None
+
+
+def _node_refs(scene: Scene, part: PartSpec):
+    """(where, key, reference) of every node reference to the part in the scene."""
+    for item in part.items:
+        for key in ("node", "node_a", "node_b", "master", "reference", "nodes", "slaves",
+                    "patch"):
+            if item.values.get(key) is not None:
+                yield item.where, key, item.values[key]
+    for item in (part.reduction.interface if part.reduction else ()):
+        yield item.where, "nodes", item.nodes
+    for mount in scene.mounts:
+        if mount.part == part.name:
+            yield from ((a.where, "node", a.node) for a in mount.attachments)
+    response = scene.analyses.response
+    for p, node, _ in (response.frame_dofs if response is not None else ()):
+        if p == part.name:
+            yield scene.analyses.where["response"], "frame_dofs", node
 
 
 def edges_to_node_sets(mesh: fm.Mesh, names) -> fm.Mesh:
@@ -191,7 +244,33 @@ def _check_outputs(scene: Scene, models: dict) -> None:
 
 
 def part_model(scene: Scene, part: PartSpec, mesh: fm.Mesh) -> fm.FEModel:
-    """:func:`femmech.build_model` of the part (assembly of K and M)."""
+    """:func:`femmech.build_model` of the part (assembly of K and M).
+
+    Its :class:`~femmech.errors.ModelWarning` s are silenced: :func:`prepare` reports the
+    same findings (:func:`part_findings`), where scene attachments count as anchors.
+    """
+    try:
+        args = _model_args(scene, part)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ModelWarning)
+            return fm.build_model(mesh, **args)
+    except (ValueError, TypeError) as exc:
+        raise fail(scene, part.where, None, str(exc)) from None
+
+
+def part_findings(scene: Scene, part: PartSpec, mesh: fm.Mesh) -> tuple:
+    """:func:`femmech.model.model_findings` of the part, without assembly; the nodes of
+    mount attachments and of a reduction interface count as held (anchors)."""
+    anchors = [a.node for m in scene.mounts if m.part == part.name for a in m.attachments]
+    anchors += [i.nodes for i in (part.reduction.interface if part.reduction else ())]
+    try:
+        return model_findings(mesh, **_model_args(scene, part), anchors=anchors)
+    except (ValueError, TypeError) as exc:
+        raise fail(scene, part.where, None, str(exc)) from None
+
+
+def _model_args(scene: Scene, part: PartSpec) -> dict:
+    """Keyword arguments of :func:`femmech.build_model` for the part (without the mesh)."""
     mats = {n: fm.Material(E=m.E, rho=m.rho, nu=m.nu, G=m.G, name=n)
             for n, m in scene.materials.items()}
     beams, shells, solids = {}, {}, {}
@@ -206,13 +285,10 @@ def part_model(scene: Scene, part: PartSpec, mesh: fm.Mesh) -> fm.FEModel:
     lists = {kind: [] for kind in _ITEMS}
     for item in part.items:
         lists[item.kind].append(_ITEMS[item.kind](**item.values))
-    try:
-        return fm.build_model(mesh, beams, masses=lists["mass"], springs=lists["spring"],
-                              supports=lists["support"], rigid_links=lists["rigid_link"],
-                              interpolating_links=lists["interpolating_link"],
-                              shells=shells or None, solids=solids or None)
-    except (ValueError, TypeError) as exc:
-        raise fail(scene, part.where, None, str(exc)) from None
+    return {"beams": beams, "masses": lists["mass"], "springs": lists["spring"],
+            "supports": lists["support"], "rigid_links": lists["rigid_link"],
+            "interpolating_links": lists["interpolating_link"], "shells": shells or None,
+            "solids": solids or None}
 
 
 def _section(s) -> fm.BeamSection:

@@ -15,6 +15,7 @@ from __future__ import annotations
 import json
 import sys
 import time
+import warnings
 from collections.abc import Callable
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -23,13 +24,14 @@ from pathlib import Path
 import femmech as fm
 from femmech.cache import cached_reduction, default_cache_dir
 from femmech.coupling import couple
-from femmech.errors import SceneError
+from femmech.errors import ModelWarning, SceneError
 from femmech.output.export import atomic_path
 from femmech.report import Section, Table, write_report
 from femmech.scene import Scene, load_scene
 from femmech.scene_build import (
     Prepared,
     fail,
+    finding_lines,
     machine_mounts,
     part_model,
     prepare,
@@ -204,10 +206,12 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
     prepared = prepare(scene)
     ws = Workshop(prepared, cache, emit, bars)
     ws.timings["prepare"] = time.perf_counter() - start
+    for line in finding_lines(prepared):
+        emit(line)
     sections, results = [], {}
     requested = [k for k in TASKS if getattr(scene.analyses, k) is not None]
     for kind in progress(requested, "analyses", bars):
-        with ws.timed(f"analysis {kind}"):
+        with ws.timed(f"analysis {kind}"), logged_warnings(emit, f"analysis {kind}"):
             try:
                 section, numbers = TASKS[kind](ws, getattr(scene.analyses, kind), out)
             except SceneError:
@@ -229,6 +233,23 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
     title = scene.name + (f" — {scene.description}" if scene.description else "")
     report = write_report(out, title, meta, sections, lines)
     return RunResult(out, report, results, tuple(lines), dict(ws.timings))
+
+
+@contextmanager
+def logged_warnings(emit: Callable[[str], None], step: str):
+    """:class:`~femmech.errors.ModelWarning` s raised inside go to the run log as
+    ``warning: <step>: <message>``; other warnings pass on unchanged."""
+    caught = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ModelWarning)
+            yield
+    finally:
+        for w in caught:
+            if issubclass(w.category, ModelWarning):
+                emit(f"warning: {step}: {w.message}")
+            else:
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
 def _write_json(path: Path, data) -> None:

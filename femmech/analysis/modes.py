@@ -7,18 +7,11 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from femmech import solvers
+from femmech import checks, solvers
 from femmech.dofs import DOF_PER_NODE
-from femmech.linalg import default_shift, eigenvalue_scale, solve_symmetric
+from femmech.linalg import RIGID_TOL, default_shift, eigenvalue_scale, solve_symmetric
 from femmech.model import FEModel
 from femmech.reduction import Superelement, frequency_error_estimates
-
-RIGID_TOL = 1e-12
-"""Eigenvalues with ``|ω²| <= RIGID_TOL * scale`` are rigid-body modes (scale: see
-:func:`model_eigenvalue_scale`, a typical element eigenvalue). Computed rigid-body
-eigenvalues are ~1e-17 of the scale (also on free shells at span/thickness 1e4, whose
-lowest elastic eigenvalue is 3e-10 of it); elastic modes of 1e-12 of the scale are ~1e-6
-of the typical element frequency."""
 
 
 @dataclass(frozen=True)
@@ -93,7 +86,8 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
     n_modes : int, optional
         Number of lowest modes.
     band_hz : (float, float), optional
-        All modes with ``f_lo <= f <= f_hi``, Hz (exactly one of n_modes and band_hz).
+        All modes with ``f_lo <= f <= f_hi``, Hz (exactly one of n_modes and band_hz). A
+        band from 0 holds all rigid-body modes (:data:`femmech.linalg.RIGID_TOL`).
     sigma : float, optional
         Shift in rad²/s² (default: ``-1e-6 ×`` the eigenvalue scale, or the band centre).
     check : bool
@@ -111,6 +105,12 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
     Returns
     -------
     ModeSet
+
+    Warns
+    -----
+    ModelWarning
+        For a first elastic frequency that only a unit mix-up gives
+        (:func:`femmech.checks.frequency_findings`).
 
     Examples
     --------
@@ -139,7 +139,18 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
                                      check=check, scale=scale)
     else:
         raise ValueError(f"method must be 'shift-invert' or 'lobpcg', got {method!r}")
-    return _mode_set(result, model.expand(result.vectors), scale)
+    out = _mode_set(result, model.expand(result.vectors), scale)
+    lowest = band is None or band[0] <= RIGID_TOL * scale
+    checks.warn(checks.frequency_findings(out.freq_hz, out.rigid, is_supported(model), lowest))
+    return out
+
+
+def is_supported(model: FEModel) -> bool:
+    """True if some DOF is fixed (a support), i.e. a row of T is empty and the DOF is not
+    an inactive rotation of a solid node."""
+    empty = np.diff(model.T.tocsr().indptr) == 0
+    empty[model.inactive] = False
+    return bool(empty.any())
 
 
 def _lobpcg(model: FEModel, n_modes, band, sigma):
@@ -215,11 +226,15 @@ def superelement_modes(se: Superelement, n_modes: int | None = None,
     lam_max = _largest_eigenvalue(Kr, Mr)
     result = solve_symmetric(Kr, Mr, n_modes=n_modes, band=_band(band_hz),
                              sigma=default_shift(Kr, Mr), scale=1e-3 * lam_max,
+                             rigid_tol=RIGID_TOL * lam_max,
                              dense_below=np.iinfo(np.int64).max)
     estimate = None
     if model is not None:
         estimate = frequency_error_estimates(model, se, result.omega2, result.vectors)
-    return _mode_set(result, se.recover(result.vectors), lam_max, estimate)
+    out = _mode_set(result, se.recover(result.vectors), lam_max, estimate)
+    lowest = band_hz is None or band_hz[0] == 0
+    checks.warn(checks.frequency_findings(out.freq_hz, out.rigid, False, lowest))
+    return out
 
 
 def _largest_eigenvalue(K, M) -> float:
