@@ -170,7 +170,7 @@ def rigid_check(phi, n_modes: int = 8):
 
 
 def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int = 70,
-             zetas=(0.0025, 0.005, 0.01, 0.02), n_steps: int = 128) -> dict:
+             zetas=(0.0025, 0.005, 0.01, 0.02), n_steps: int = 32) -> dict:
     """Periodic steady state at ``spm`` strokes/min and Floquet stability over speed.
 
     Steady state (shooting, Richardson-extrapolated; ρ∞ = 1 so that the rigid-attachment

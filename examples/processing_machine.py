@@ -213,7 +213,7 @@ def rigid_check(phi, rho_scale: float = 1e-6):
 
 def dynamics(out_dir="out/processing_machine", rpm: float = OPERATING_RPM,
              n_speeds: int = 70, zetas=(0.0025, 0.005, 0.01, 0.02),
-             n_steps: int = 128) -> dict:
+             n_steps: int = 32) -> dict:
     """Periodic steady state at ``rpm`` and Floquet stability over speed.
 
     Steady state (shooting, ρ∞ = 1, Richardson-extrapolated): follower deformations q of

@@ -160,7 +160,7 @@ def build(n_cams: int = 10, f_max_hz: float = 400.0, per_spacing: int = 2):
 
 def dynamics(out_dir="out/textile", n_cams: int = 10, rpm: float = OPERATING_RPM,
              n_speeds: int = 60, zetas=(0.0025, 0.005, 0.01, 0.02),
-             n_steps: int = 128) -> dict:
+             n_steps: int = 32) -> dict:
     """Periodic steady state at ``rpm`` and Floquet stability over speed.
 
     Steady state (shooting, ρ∞ = 1, Richardson-extrapolated): follower deflections of the

@@ -210,6 +210,39 @@ def assemble_at(system: CoupledSystem, blocks, index: int):
     return M, B, C, F
 
 
+def assemble_stack(system: CoupledSystem, blocks):
+    """Dense M, B, C (k, n, n) and F (k, n) at all k angles of ``blocks`` at once.
+
+    The vectorised form of :func:`assemble_at` for reduced frames (time integrators need
+    the matrices at many time points).
+    """
+    require_dense_primal(system, "assemble_stack")
+    k = blocks[0][0].shape[0] if blocks else 1
+    M, B, C = (np.repeat(A[None], k, axis=0) for A in (system.M0, system.B0, system.K0))
+    F = np.zeros((k, system.n))
+    for idx, (Mm, Bm, Cm, Fm) in zip(system.touched, blocks, strict=True):
+        ix = (slice(None), idx[:, None], idx[None, :])
+        M[ix] += Mm
+        B[ix] += Bm
+        C[ix] += Cm
+        F[:, idx] += Fm
+    return M, B, C, F
+
+
+def drive_breakpoints(system: CoupledSystem, angle_period: float = 2 * np.pi) -> np.ndarray:
+    """Main-drive angles in [0, Θ), rad, where a mounted mechanism's matrices may jump.
+
+    The breakpoints of each mount's model (``model.breakpoints()``, e.g. the joints of a
+    cam programme, in the mechanism's own angle θ = ratio φ + phase) mapped to the main
+    drive angle φ over the cycle Θ = ``angle_period``. Sorted and unique.
+    """
+    from femmech.mechanisms.position import preimages
+
+    found = [preimages(get(), m.ratio, m.phase, angle_period) for m in system.mounts
+             if (get := getattr(m.model, "breakpoints", None)) is not None]
+    return np.unique(np.concatenate(found)) if found else np.zeros(0)
+
+
 def frame_row(frame, node, direction) -> np.ndarray:
     """Row vector L (n_frame,) with ``Σ w_k u_k(node) = L u`` for frame coordinates u."""
     w = _weights(direction)

@@ -29,6 +29,8 @@ figure img{max-width:min(100%,720px);border:1px solid #dde}
 figcaption{font-size:.85em;color:#444}
 .gallery img{width:340px}pre{background:#f6f6f6;padding:.7em;overflow-x:auto;font-size:.82em}
 ul.files{font-size:.9em}
+.warning{border-left:4px solid #c0392b;background:#fdecea;padding:.4em .8em}
+td.flagged{background:#fdecea;color:#8b1a10;font-weight:600}
 """
 
 
@@ -63,6 +65,9 @@ class Section:
         Data files (relative names) to link.
     gallery : bool
         Show the figures as small thumbnails (mode images).
+    warnings : tuple of str
+        Findings the reader must not miss (unconverged results), shown highlighted
+        before the tables.
     """
 
     title: str
@@ -72,9 +77,19 @@ class Section:
     files: tuple = ()
     gallery: bool = False
     anchor: str = field(default="")
+    warnings: tuple = ()
+
+
+@dataclass(frozen=True)
+class Flagged:
+    """A table cell whose value may be wrong (e.g. not converged): shown highlighted."""
+
+    text: str
 
 
 def _cell(value) -> str:
+    if isinstance(value, Flagged):
+        return html.escape(value.text)
     if isinstance(value, float):
         return html.escape(f"{value:.6g}")
     return html.escape(str(value))
@@ -83,8 +98,9 @@ def _cell(value) -> str:
 def render_table(table: Table) -> str:
     """HTML of one table."""
     head = "".join(f"<th>{_cell(h)}</th>" for h in table.header)
-    body = "".join("<tr>" + "".join(f"<td>{_cell(c)}</td>" for c in row) + "</tr>"
-                   for row in table.rows)
+    body = "".join("<tr>" + "".join(
+        f'<td class="flagged">{_cell(c)}</td>' if isinstance(c, Flagged) else
+        f"<td>{_cell(c)}</td>" for c in row) + "</tr>" for row in table.rows)
     return (f"<table><caption>{html.escape(table.caption)}</caption><thead><tr>{head}</tr>"
             f"</thead><tbody>{body}</tbody></table>")
 
@@ -99,6 +115,7 @@ def render_section(section: Section, anchor: str) -> str:
     """HTML of one section."""
     parts = [f'<section id="{anchor}"><h2>{html.escape(section.title)}</h2>']
     parts += [f"<p>{html.escape(p)}</p>" for p in section.paragraphs]
+    parts += [f'<p class="warning">&#9888; {html.escape(w)}</p>' for w in section.warnings]
     parts += [render_table(t) for t in section.tables]
     if section.figures:
         cls = ' class="gallery"' if section.gallery else ""

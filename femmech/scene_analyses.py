@@ -16,6 +16,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from femmech.analysis.response import STEADY_STATE_MAX_STEPS, STEADY_STATE_RTOL
+from femmech.analysis.stability import MAX_STEPS as MONODROMY_MAX_STEPS
+from femmech.analysis.stability import RTOL as MONODROMY_RTOL
 from femmech.scene_reader import Reader
 from femmech.units import ANGLE, DIMENSIONLESS, FREQUENCY, INVERSE_TIME, SPEED, TIME
 
@@ -53,6 +56,8 @@ class StabilitySpec:
     angle_period: float
     rayleigh: tuple
     tol: float
+    rtol: float
+    max_steps: int
 
 
 @dataclass(frozen=True)
@@ -69,6 +74,8 @@ class ResponseSpec:
     outputs: tuple
     frame_dofs: tuple
     rayleigh: tuple
+    rtol: float
+    max_steps: int
 
 
 @dataclass(frozen=True)
@@ -190,9 +197,13 @@ def _stability(t: Reader, parts, mechanisms, has_mounts) -> StabilitySpec:
     if speeds is None or len(speeds) < 2 or min(speeds) <= 0:
         raise t.error("speeds", "expected >= 2 positive drive speeds (list or {start, stop,"
                                 " n}), e.g. {start = '100 rpm', stop = '3000 rpm', n = 30}")
-    return StabilitySpec(speeds, t.integer("n_steps", 128, minimum=4),
+    n_steps = t.integer("n_steps", 32, minimum=4)
+    return StabilitySpec(speeds, n_steps,
                          t.number("angle_period", ANGLE, 2 * np.pi, positive=True),
-                         _rayleigh(t), t.number("tol", DIMENSIONLESS, 1e-6, positive=True))
+                         _rayleigh(t), t.number("tol", DIMENSIONLESS, 1e-6, positive=True),
+                         t.number("rtol", DIMENSIONLESS, MONODROMY_RTOL, positive=True),
+                         t.integer("max_steps", MONODROMY_MAX_STEPS, minimum=n_steps,
+                                   maximum=2**20))
 
 
 def _response(t: Reader, parts, mechanisms, has_mounts) -> ResponseSpec:
@@ -213,8 +224,12 @@ def _response(t: Reader, parts, mechanisms, has_mounts) -> ResponseSpec:
         dofs.append((part, d.node_ref("node"),
                      d.string("dof", choices=("ux", "uy", "uz", "rx", "ry", "rz"))))
         d.finish()
-    return ResponseSpec(kind, speed, t.integer("n_steps", 512, minimum=2), *ramp,
-                        t.strings("outputs", ()), tuple(dofs), _rayleigh(t))
+    n_steps = t.integer("n_steps", 512, minimum=2)
+    return ResponseSpec(kind, speed, n_steps, *ramp, t.strings("outputs", ()), tuple(dofs),
+                        _rayleigh(t),
+                        t.number("rtol", DIMENSIONLESS, STEADY_STATE_RTOL, positive=True),
+                        t.integer("max_steps", STEADY_STATE_MAX_STEPS, minimum=n_steps,
+                                  maximum=2**20))
 
 
 def _check(t: Reader, parts, mechanisms, has_mounts) -> CheckSpec:

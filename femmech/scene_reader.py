@@ -96,8 +96,9 @@ class Reader:
             raise self.error(key, f"expected a list of {len(kinds)} values, got {_show(value)}")
         return tuple(self.convert(key, v, k) for v, k in zip(value, kinds, strict=True))
 
-    def integer(self, key: str, default=_MISSING, minimum: int | None = None):
-        """An integer (TOML integer, not a float or bool)."""
+    def integer(self, key: str, default=_MISSING, minimum: int | None = None,
+                maximum: int | None = None):
+        """An integer (TOML integer, not a float or bool) in [minimum, maximum]."""
         value = self.get(key, default)
         if value is default and default is not _MISSING:
             return default
@@ -105,6 +106,8 @@ class Reader:
             raise self.error(key, f"expected an integer, got {_show(value)}")
         if minimum is not None and value < minimum:
             raise self.error(key, f"expected an integer >= {minimum}, got {value}")
+        if maximum is not None and value > maximum:
+            raise self.error(key, f"expected an integer <= {maximum}, got {value}")
         return value
 
     def boolean(self, key: str, default=_MISSING):

@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import io
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,15 +26,17 @@ from femmech.analysis.response import (
     rayleigh_damping,
     time_response,
 )
-from femmech.analysis.stability import StabilityChart, stability_chart
+from femmech.analysis.stability import stability_chart
+from femmech.analysis.studies import merge_charts
 from femmech.analysis.sweep import sweep
 from femmech.coupling import couple
+from femmech.errors import ConvergenceWarning
 from femmech.mechanisms import plot_quasi_frequencies, quasi_modes
 from femmech.model import node_index
 from femmech.output import export_modes_vtu, frequency_table, plot_mac, write_frequency_csv
 from femmech.output.diagrams import plot_stability_chart
 from femmech.output.export import atomic_path
-from femmech.report import Figure, Section, Table
+from femmech.report import Figure, Flagged, Section, Table
 from femmech.scene_build import machine_mounts
 from femmech.scene_run import progress, timings_table
 
@@ -205,41 +208,63 @@ def _damped(ws, rayleigh):
 
 
 def run_stability(ws, spec, out):
-    """Floquet spectral radius over drive speed (stability chart)."""
+    """Floquet spectral radius over drive speed (stability chart), each point checked."""
     system = _damped(ws, spec.rayleigh)
     speeds = np.asarray(spec.speeds, dtype=float)
-    radius = np.array([stability_chart(system, [W], n_steps=spec.n_steps,
-                                       angle_period=spec.angle_period,
-                                       tol=spec.tol).spectral_radius[0, 0]
-                       for W in progress(speeds, "stability", ws.bars)])
-    chart = StabilityChart(speeds, None, radius[None], radius[None] <= 1 + spec.tol, spec.tol)
-    plot_stability_chart(chart, out / "stability_chart.png", title=ws.scene.name)
-    _write_csv(out / "stability.csv", ["speed_rad_s", "speed_rpm", "spectral_radius", "stable"],
-               [(W, W * RPM, r, int(r <= 1 + spec.tol)) for W, r in zip(speeds, radius,
-                                                                        strict=True)])
-    unstable = speeds[radius > 1 + spec.tol]
-    text = (f"{speeds.size} speeds from {speeds[0] * RPM:.0f} to {speeds[-1] * RPM:.0f} rpm,"
-            f" {spec.n_steps} Magnus steps per period; Rayleigh damping (mass, stiffness)"
-            f" = {spec.rayleigh}. Unstable at {unstable.size} speeds"
+    with warnings.catch_warnings():  # unconverged points are marked below, not warned
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        points = [stability_chart(system, [W], n_steps=spec.n_steps,
+                                  angle_period=spec.angle_period, tol=spec.tol,
+                                  rtol=spec.rtol, max_steps=spec.max_steps)
+                  for W in progress(speeds, "stability", ws.bars)]
+    chart = merge_charts(points, 1, len(points), speeds, None)
+    radius, error = chart.spectral_radius[0], chart.error[0]
+    ok, steps = chart.converged[0], chart.n_steps[0]
+    plot_stability_chart(chart, out / "stability_chart.png", title=ws.scene.name,
+                         speed_unit="rpm")
+    _write_csv(out / "stability.csv", ["speed_rad_s", "speed_rpm", "spectral_radius",
+                                       "error_estimate", "converged", "n_steps", "stable"],
+               [(W, W * RPM, r, e, int(c), n, int(r <= 1 + spec.tol) if c else "")
+                for W, r, e, c, n in zip(speeds, radius, error, ok, steps, strict=True)])
+    unstable = speeds[(radius > 1 + spec.tol) & ok]
+    text = (f"{speeds.size} speeds from {speeds[0] * RPM:.0f} to {speeds[-1] * RPM:.0f} rpm;"
+            f" Rayleigh damping (mass, stiffness) = {spec.rayleigh}. Magnus steps per period"
+            f" doubled from {spec.n_steps} until the spectral radius changed by at most"
+            f" {spec.rtol:g} (relative; {steps.min()}..{steps.max()} steps were needed)."
+            f" Unstable at {unstable.size} speeds"
             + (f" ({unstable.min() * RPM:.0f}..{unstable.max() * RPM:.0f} rpm)." if
                unstable.size else "."),)
-    rows = tuple((float(W * RPM), float(r), "yes" if r <= 1 + spec.tol else "no")
-                 for W, r in zip(speeds, radius, strict=True))
+    flags = ()
+    if not ok.all():
+        bad = speeds[~ok] * RPM
+        flags = (f"{int((~ok).sum())} of {speeds.size} speeds ({bad.min():.0f}..{bad.max():.0f}"
+                 f" rpm) did NOT converge within max_steps = {spec.max_steps} Magnus steps per"
+                 " period: their spectral radius and verdict may be wrong (hatched in the"
+                 " chart, converged = 0 in stability.csv). Raise max_steps.",)
+        ws.log(f"stability: {flags[0]}")
+    rows = tuple((float(W * RPM), float(r), f"{e:.1e}", "yes" if r <= 1 + spec.tol else "no")
+                 if c else (float(W * RPM), Flagged(f"{r:.6g} NOT CONVERGED"), f"{e:.1e}",
+                            Flagged("unknown"))
+                 for W, r, e, c in zip(speeds, radius, error, ok, strict=True))
     section = Section("Stability chart", text, (Table("Spectral radius of the monodromy"
                                                       " matrix", ("speed (rpm)", "max |μ|",
+                                                                  "error estimate",
                                                                   "stable"), rows),),
                       (Figure("stability_chart.png", "Floquet stability over drive speed"),),
-                      ("stability.csv",))
-    return section, {"speeds_rad_s": _list(speeds), "spectral_radius": _list(radius)}
+                      ("stability.csv",), warnings=flags)
+    return section, {"speeds_rad_s": _list(speeds), "spectral_radius": _list(radius),
+                     "error_estimate": _list(error), "converged": [bool(c) for c in ok]}
 
 
 def run_response(ws, spec, out):
     """Periodic steady state or run-up: histories of chosen coordinates."""
     system = _damped(ws, spec.rayleigh)
     labels = list(system.labels)  # outputs checked against them by scene_build.prepare
-    with ws.timed("time integration"):
+    with ws.timed("time integration"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConvergenceWarning)  # marked in the report
         if spec.kind == "periodic":
-            r = periodic_steady_state(system, spec.speed, n_steps=spec.n_steps)
+            r = periodic_steady_state(system, spec.speed, n_steps=spec.n_steps,
+                                      rtol=spec.rtol, max_steps=spec.max_steps)
         else:
             t = np.linspace(0.0, spec.t_end, spec.n_steps + 1)
             r = time_response(system, t, SpeedRamp(spec.speed_start, spec.speed_end,
@@ -254,17 +279,38 @@ def run_response(ws, spec, out):
                [(t, p, *(c[i] for c in columns.values()))
                 for i, (t, p) in enumerate(zip(r.t, r.phi, strict=True))])
     _plot_response(r, columns, spec.kind, out / "response.png")
-    rows = tuple((k, float(np.abs(c).max()), float(c.max() - c.min()))
+    loose = r.converged is False
+
+    def cell(x):
+        return Flagged(f"{x:.6g} NOT CONVERGED") if loose else float(x)
+
+    rows = tuple((k, cell(np.abs(c).max()), cell(c.max() - c.min()))
                  for k, c in columns.items())
-    text = ((f"Periodic steady state at {spec.speed * RPM:.0f} rpm" if spec.kind == "periodic"
-             else f"Run-up {spec.speed_start * RPM:.0f} → {spec.speed_end * RPM:.0f} rpm in"
-                  f" {spec.duration:g} s") + f", {spec.n_steps} steps (generalised-α).",)
+    if spec.kind == "periodic":
+        text = (f"Periodic steady state at {spec.speed * RPM:.0f} rpm by shooting"
+                f" (generalised-α), {r.n_steps} steps per period: steps doubled from"
+                f" {spec.n_steps} until q changed by at most {spec.rtol:g} (relative, mass"
+                f" norm); estimated error {r.error:.1e}.",)
+    else:
+        text = (f"Run-up {spec.speed_start * RPM:.0f} → {spec.speed_end * RPM:.0f} rpm in"
+                f" {spec.duration:g} s, {spec.n_steps} steps (generalised-α, fixed steps).",)
+    flags = ()
+    if loose:
+        flags = (f"The periodic steady state did NOT converge within max_steps ="
+                 f" {spec.max_steps} steps per period (estimated error {r.error:.1e} >"
+                 f" {spec.rtol:g}): its amplitudes may be wrong. Raise max_steps.",)
+        ws.log(f"response: {flags[0]}")
     section = Section("Forced response", text, (Table("Amplitudes (m, rad or modal)",
                                                       ("coordinate", "max |x|",
                                                        "peak to peak"), rows),),
-                      (Figure("response.png", "Response histories"),), ("response.csv",))
-    return section, {k: {"max_abs": float(np.abs(c).max()), "peak_to_peak":
-                         float(c.max() - c.min())} for k, c in columns.items()}
+                      (Figure("response.png", "Response histories"),), ("response.csv",),
+                      warnings=flags)
+    summary = {k: {"max_abs": float(np.abs(c).max()), "peak_to_peak":
+                   float(c.max() - c.min())} for k, c in columns.items()}
+    if spec.kind == "periodic":
+        summary["convergence"] = {"converged": bool(r.converged), "error_estimate":
+                                  float(r.error), "n_steps": int(r.n_steps)}
+    return section, summary
 
 
 def _plot_response(r, columns, kind, path) -> None:

@@ -28,12 +28,14 @@ the excitation are damped (ρ∞ < 1) without touching the resolved low modes, w
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from femmech.coupling import CoupledSystem, assemble_at, frame_row, require_dense_primal
 from femmech.dofs import COMPONENTS, DOF_PER_NODE
+from femmech.errors import ConvergenceWarning
 from femmech.model import node_index
 
 
@@ -49,6 +51,16 @@ class Response:
         Coordinates (m, rad, modal), their velocities and accelerations.
     phi : ndarray (n_t,)
         Main drive angle φ(t), rad.
+    error : float
+        Periodic steady state: estimated relative error of q (step doubling, see
+        :func:`periodic_steady_state`); NaN without a check.
+    converged : bool or None
+        Whether ``error`` met the tolerance; ``None`` when unchecked (time responses on
+        the user's grid, fixed-step steady states). An unconverged result is a number
+        that may be wrong.
+    n_steps : int or None
+        Integration steps per period behind a steady state (the output grid may be
+        coarser).
     """
 
     t: np.ndarray
@@ -56,6 +68,9 @@ class Response:
     v: np.ndarray
     a: np.ndarray
     phi: np.ndarray
+    error: float = float("nan")
+    converged: bool | None = None
+    n_steps: int | None = None
 
 
 @dataclass(frozen=True)
@@ -234,18 +249,35 @@ def _initial(x, n, name):
     return x
 
 
+STEADY_STATE_RTOL = 1e-3
+"""Default tolerance of a periodic steady state: relative change of q (mass norm)."""
+
+STEADY_STATE_MAX_STEPS = 2**15
+"""Default cap on the integration steps per period of the step-doubling loop."""
+
+
 def periodic_steady_state(system, Omega: float, n_steps: int = 512, rho_inf: float = 0.8,
                           angle_period: float = 2 * np.pi, phi0: float = 0.0,
-                          richardson: bool = False) -> Response:
-    """Periodic forced response at constant drive speed, by shooting.
+                          richardson: bool = False, rtol: float | None = STEADY_STATE_RTOL,
+                          max_steps: int = STEADY_STATE_MAX_STEPS) -> Response:
+    """Periodic forced response at constant drive speed, by shooting, with error control.
 
     With φ = φ₀ + Ω t the coefficients and the force repeat with T = Θ/Ω. The
-    generalised-α map over one period (n_steps steps, initial acceleration from the
-    equation of motion) is affine in z = [q; q']: ``z(T) = Φ z(0) + z_p`` with Φ from the
-    2n unit initial states (integrated together with the forced column z_p, from rest)
-    and z_p the response to F. The periodic state is ``z(0) = (I - Φ)⁻¹ z_p``; its history
-    is integrated once more. q and q' are periodic to round-off (z(T) = z(0)); the
-    discretisation error is that of the integrator, O((T/n_steps)²).
+    generalised-α map over one period (N steps, initial acceleration from the equation
+    of motion) is affine in z = [q; q']: ``z(T) = Φ z(0) + z_p`` with Φ from the 2n unit
+    initial states (integrated together with the forced column z_p, from rest) and z_p
+    the response to F. The periodic state is ``z(0) = (I - Φ)⁻¹ z_p``; its history is
+    integrated once more. q and q' are periodic to round-off (z(T) = z(0)); the
+    discretisation error is that of the integrator, O((T/N)²).
+
+    Error control (step doubling): N starts at ``n_steps`` and doubles until two
+    successive solutions differ by at most ``rtol`` on the output grid, measured as
+    max_t ‖Δq(t)‖_M / max_t ‖q(t)‖_M in the mass norm at t = 0 (a unit-independent
+    norm over all coordinates). The estimate is that of the coarser solution; the finer
+    one, returned, is about 3 times (second order) or 15 times (Richardson) closer.
+    At low speed the period is long against the frame's vibration periods and more
+    steps are needed; a result that misses ``rtol`` within ``max_steps`` comes back with
+    ``converged=False`` and a :class:`~femmech.errors.ConvergenceWarning`.
 
     Parameters
     ----------
@@ -253,7 +285,7 @@ def periodic_steady_state(system, Omega: float, n_steps: int = 512, rho_inf: flo
     Omega : float
         Drive speed, rad/s, > 0.
     n_steps : int
-        Steps per period.
+        Output points per period (t has n_steps + 1 points) and the first step count.
     rho_inf : float
         Generalised-α spectral radius at infinity.
     angle_period : float
@@ -261,20 +293,26 @@ def periodic_steady_state(system, Omega: float, n_steps: int = 512, rho_inf: flo
     phi0 : float
         Drive angle at t = 0, rad.
     richardson : bool
-        Also solve with 2 n_steps and return (4 x_{h/2} − x_h)/3 on the n_steps grid
+        Combine each pair of solutions as (4 x_{h/2} − x_h)/3 on the coarser grid
         (Richardson extrapolation of q, q', q''). With ρ∞ = 1 (trapezoidal rule, a
         symmetric method whose global error expands in even powers of h: Hairer,
         Nørsett & Wanner, Solving ODEs I, sect. II.8) the error falls from O(h²) to
-        O(h⁴) for three times the work; the combination still satisfies the equation of
-        motion at the grid points (weights summing to 1, linear equations). Worth it near
-        resonances, where the O(h²) frequency error of the integrator shifts the
-        resonance peak (benchmarks/response.py: 1.4 % at 512 steps, 3e-4 extrapolated).
-        For ρ∞ < 1 the gain is one order only.
+        O(h⁴); the combination still satisfies the equation of motion at the grid points
+        (weights summing to 1, linear equations). Worth it near resonances, where the
+        O(h²) frequency error of the integrator shifts the resonance peak
+        (benchmarks/response.py: 1.4 % at 512 steps, 3e-4 extrapolated). For ρ∞ < 1
+        the gain is one order only.
+    rtol : float or None
+        Tolerance of the step-doubling check; ``None``: integrate with ``n_steps`` only
+        (and 2 n_steps for Richardson), unchecked.
+    max_steps : int
+        Largest step count per period tried.
 
     Returns
     -------
     Response
-        Over one period, t = 0..T (n_steps + 1 points).
+        Over one period, t = 0..T (n_steps + 1 points), with ``error``, ``converged``
+        and the steps per period behind it (``n_steps``).
 
     Raises
     ------
@@ -284,14 +322,77 @@ def periodic_steady_state(system, Omega: float, n_steps: int = 512, rho_inf: flo
     """
     if not (np.isfinite(Omega) and Omega > 0):
         raise ValueError(f"drive speed Omega must be positive, got {Omega} rad/s")
-    if int(n_steps) != n_steps or n_steps < 2:
-        raise ValueError(f"n_steps must be an integer >= 2, got {n_steps}")
+    n_steps = check_step_control(n_steps, rtol, max_steps, minimum=2)
+
+    def solve(n):
+        return _shooting(system, Omega, n, rho_inf, angle_period, phi0)
+
+    solutions = [solve(n_steps)]
     if richardson:
-        coarse = periodic_steady_state(system, Omega, n_steps, rho_inf, angle_period, phi0)
-        fine = periodic_steady_state(system, Omega, 2 * int(n_steps), rho_inf, angle_period,
-                                     phi0)
-        combined = [(4 * getattr(fine, k)[::2] - getattr(coarse, k)) / 3 for k in "qva"]
-        return Response(coarse.t, *combined, coarse.phi)
+        solutions.append(solve(2 * n_steps))
+    if rtol is None:
+        result = _extrapolated(*solutions) if richardson else solutions[0]
+        return replace(result, n_steps=2 * n_steps if richardson else n_steps)
+    mass = _matrices(system, *ConstantSpeed(Omega, phi0)(np.zeros(1)))(0)[0]
+    error, converged = np.inf, False
+    while 2 * (n := n_steps * 2 ** (len(solutions) - 1)) <= max_steps:
+        solutions.append(solve(2 * n))
+        levels = solutions if not richardson else \
+            [_extrapolated(a, b) for a, b in zip(solutions, solutions[1:], strict=False)]
+        if len(levels) >= 2:
+            error = _change(levels[-2], levels[-1], mass)
+            if error <= rtol:
+                converged = True
+                break
+    finest = _extrapolated(*solutions[-2:]) if richardson else solutions[-1]
+    every = (finest.t.size - 1) // n_steps
+    result = Response(finest.t[::every], finest.q[::every], finest.v[::every],
+                      finest.a[::every], finest.phi[::every], float(error), converged,
+                      (finest.t.size - 1) * (2 if richardson else 1))
+    if not converged:
+        warnings.warn(f"periodic steady state at {Omega:.6g} rad/s did not converge:"
+                      f" estimated relative error {error:.2g} > rtol {rtol:g} after"
+                      f" {result.n_steps} steps per period; raise max_steps",
+                      ConvergenceWarning, stacklevel=2)
+    return result
+
+
+def check_step_control(n_steps, rtol, max_steps, minimum: int = 1) -> int:
+    """Validate the step-doubling settings of a periodic solve; return ``n_steps`` as int.
+
+    ``n_steps`` an integer >= ``minimum``, ``rtol`` positive or None (fixed steps),
+    ``max_steps`` an integer >= ``n_steps``; a ValueError names the offending one.
+    """
+    if isinstance(n_steps, bool) or int(n_steps) != n_steps or n_steps < minimum:
+        raise ValueError(f"n_steps must be an integer >= {minimum}, got {n_steps}")
+    if rtol is not None and not (np.isfinite(rtol) and rtol > 0):
+        raise ValueError(f"rtol must be positive (or None for fixed steps), got {rtol}")
+    if isinstance(max_steps, bool) or int(max_steps) != max_steps or max_steps < n_steps:
+        raise ValueError(f"max_steps must be an integer >= n_steps = {n_steps}, got"
+                         f" {max_steps}")
+    return int(n_steps)
+
+
+def _extrapolated(coarse: Response, fine: Response) -> Response:
+    """(4 x_{h/2} − x_h)/3 on the coarse grid, for q, q' and q''."""
+    combined = [(4 * getattr(fine, k)[::2] - getattr(coarse, k)) / 3 for k in "qva"]
+    return Response(coarse.t, *combined, coarse.phi)
+
+
+def _change(coarse: Response, fine: Response, mass: np.ndarray) -> float:
+    """max_t ‖q_fine − q_coarse‖_M / max_t ‖q_fine‖_M on the coarse grid."""
+    every = (fine.t.size - 1) // (coarse.t.size - 1)
+    q = fine.q[::every]
+
+    def norm(x):
+        return np.sqrt(np.abs(np.einsum("ti,ij,tj->t", x, mass, x))).max()
+
+    scale = norm(q)
+    return float(norm(q - coarse.q) / scale) if scale > 0 else 0.0
+
+
+def _shooting(system, Omega, n_steps, rho_inf, angle_period, phi0) -> Response:
+    """One shooting solve of the periodic state on n_steps equal steps (unchecked)."""
     t = np.linspace(0.0, angle_period / Omega, int(n_steps) + 1)
     drive = ConstantSpeed(Omega, phi0)
     matrices_at = _matrices(system, *drive(t))

@@ -27,6 +27,7 @@ import dataclasses
 import math
 import multiprocessing
 import os
+import warnings
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
@@ -35,6 +36,7 @@ import numpy as np
 
 from femmech import threads
 from femmech.analysis import stability
+from femmech.errors import ConvergenceWarning
 
 
 def default_workers(n_jobs: int | None = None) -> int:
@@ -174,7 +176,9 @@ def grid(func: Callable, *axes, executor: Executor | None = None, client=None,
 
 def _chart_part(system_or_callable, speeds, value, options):
     values = None if value is None else [value]
-    return stability.stability_chart(system_or_callable, speeds, values, **options)
+    with warnings.catch_warnings():  # the merged chart warns once
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        return stability.stability_chart(system_or_callable, speeds, values, **options)
 
 
 def stability_chart(system_or_callable, speeds, second_parameter_values=None,
@@ -192,7 +196,8 @@ def stability_chart(system_or_callable, speeds, second_parameter_values=None,
     executor, client, max_workers, timeout
         As in :func:`run`.
     **options
-        ``n_steps``, ``angle_period``, ``tol``, ``parameter_name``, ``basis``.
+        ``n_steps``, ``angle_period``, ``tol``, ``parameter_name``, ``basis``,
+        ``rtol``, ``max_steps``.
 
     Returns
     -------
@@ -209,11 +214,13 @@ def stability_chart(system_or_callable, speeds, second_parameter_values=None,
     jobs = [(system_or_callable, speeds[s], value, options) for value in rows for s in pieces]
     parts = run(_chart_part, jobs, executor, client, max_workers, chunksize=1,
                 timeout=timeout)
-    return _merge_charts(parts, len(rows), len(pieces), speeds, values)
+    chart = merge_charts(parts, len(rows), len(pieces), speeds, values)
+    stability.warn_unconverged_chart(chart)
+    return chart
 
 
-def _merge_charts(parts, n_rows, n_pieces, speeds, values):
-    """One chart from row × speed-piece charts: per-point arrays are joined."""
+def merge_charts(parts, n_rows, n_pieces, speeds, values):
+    """One chart from row × speed-piece charts (row-major): per-point arrays are joined."""
     first = parts[0]
     shape = first.spectral_radius.shape
     merged = {}

@@ -12,6 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
+import sympy
 
 from femmech.mechanisms.evaluate import CompiledExpressions, check_bindings, compile_expressions
 from femmech.mechanisms.lagrange import (
@@ -20,7 +21,7 @@ from femmech.mechanisms.lagrange import (
     lagrange_terms,
     rheolinear_terms,
 )
-from femmech.mechanisms.position import PositionFunction
+from femmech.mechanisms.position import PositionFunction, preimages
 from femmech.mechanisms.symbolic import Mechanism
 
 __all__ = [
@@ -104,6 +105,32 @@ class RheolinearModel:
                 " position (stroke limit, dead centre) where a position derivative is"
                 " infinite")
         return out
+
+    def breakpoints(self) -> np.ndarray:
+        """Drive angles in [0, 2π), rad, where M, B, C or F may jump (cam joints), sorted.
+
+        Collected from the position functions that offer ``breakpoints()``
+        (:class:`~femmech.mechanisms.CamProfile`) through their arguments, which must be
+        linear in the drive angle on the programmed motion (``U(θ)``, ``U(2θ + c)``);
+        other arguments, and models with several drives, contribute none. Smooth position
+        functions (linkages, quintic tabulated splines) have none.
+        """
+        if len(self.terms.drives) != 1:
+            return np.zeros(0)
+        angle = self.terms.angle[0]
+        values = {sympy.Symbol(k): v for k, v in self.parameters.items()}
+        found = []
+        matrices = (self.terms.M, self.terms.B, self.terms.C, self.terms.F)
+        for f in set().union(*(m.atoms(sympy.Function) for m in matrices)):
+            get = getattr(self.position_functions.get(getattr(f, "position_name", None)),
+                          "breakpoints", None)
+            if get is None:
+                continue
+            arg = sympy.expand(f.args[0].subs(values))
+            scale, offset = arg.diff(angle), arg.subs(angle, 0)
+            if scale.is_number and offset.is_number:
+                found.append(preimages(get(), float(scale), float(offset)))
+        return np.unique(np.concatenate(found)) if found else np.zeros(0)
 
     def M(self, phi) -> np.ndarray:
         """Mass matrix M(φ) = (m̄_jk), shape S + (n, n), symmetric."""

@@ -73,6 +73,10 @@ class PolynomialLaw:
         poly = np.polynomial.Polynomial(self.coefficients)
         return tuple(poly.deriv(k)(z) if k else poly(z) for k in range(4))
 
+    def joints(self) -> np.ndarray:
+        """Normalised angles in (0, 1) where s, ..., s''' jump: none (a polynomial)."""
+        return np.zeros(0)
+
 
 @dataclass(frozen=True)
 class SinusoidalLaw:
@@ -124,6 +128,10 @@ class SinusoidalLaw:
         s1 = v0 + c * d - a / w * (np.cos(x) - np.cos(th))
         s = s0 + v0 * d + 0.5 * c * d**2 - a / w * ((np.sin(x) - np.sin(th)) / w - d * np.cos(th))
         return s, s1, s2, s3
+
+    def joints(self) -> np.ndarray:
+        """Normalised angles in (0, 1) of the interior piece boundaries (s''' may jump)."""
+        return np.asarray(self.starts[1:], dtype=float)
 
 
 def _sinusoidal_law(name: str, pieces, continuity: int) -> SinusoidalLaw:
@@ -295,3 +303,17 @@ class CamProfile:
     def __call__(self, phi, order: int = 0) -> np.ndarray:
         """Return U^(order)(φ) at ``phi`` (rad); ``order`` is 0, 1, 2 or 3."""
         return self.derivatives(phi)[check_order(order)]
+
+    def breakpoints(self) -> np.ndarray:
+        """Drive angles in [0, 2π), rad, where U, U', U'' or U''' may jump, sorted.
+
+        The segment joints (where a law meets a dwell the jerk jumps, with the harmonic law
+        the acceleration too) and the piece boundaries inside piecewise laws. Time
+        integrators over the cycle put step boundaries there: a step across a jump loses
+        the order of the scheme (:mod:`femmech.analysis.stability`).
+        """
+        angles = [np.asarray(self._starts)]
+        for start, seg in zip(self._starts, self.segments, strict=True):
+            if seg.law is not None and seg.lift != 0:
+                angles.append(start + seg.beta * seg.law.joints())
+        return np.unique(np.mod(self.phi_start + np.concatenate(angles), TWO_PI))

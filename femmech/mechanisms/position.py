@@ -63,3 +63,20 @@ def check_order(order: int) -> int:
     if order not in (0, 1, 2, 3):
         raise ValueError(f"derivative order must be 0, 1, 2 or 3, got {order!r}")
     return int(order)
+
+
+def preimages(points, scale: float, offset: float, span: float = 2.0 * np.pi) -> np.ndarray:
+    """Angles x ∈ [0, span) with ``scale * x + offset ≡ p (mod 2π)`` for each p in points.
+
+    Maps the breakpoints of a 2π-periodic function of an angle ψ = scale · x + offset (a
+    position function of ``2 θ + c``, a mechanism geared to the main drive) to the
+    angle x. Returns them sorted and unique (rad).
+    """
+    points = np.asarray(points, dtype=float).ravel()
+    if points.size == 0 or scale == 0 or not np.isfinite(scale * offset * span):
+        return np.zeros(0)
+    lo, hi = sorted((offset, offset + scale * span))  # range of ψ over x ∈ [0, span)
+    k = np.arange(np.floor((lo - points.max()) / (2 * np.pi)),
+                  np.ceil((hi - points.min()) / (2 * np.pi)) + 1)
+    x = ((points[:, None] + 2 * np.pi * k[None, :]).ravel() - offset) / scale
+    return np.unique(x[(x >= 0) & (x < span)])

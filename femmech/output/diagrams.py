@@ -72,21 +72,21 @@ def write_sweep_json(sweep, filename, metadata: dict | None = None) -> Path:
     return Path(filename)
 
 
-def plot_stability_chart(chart, filename, title: str = "Floquet stability",
-                         speed_label: str | None = None,
-                         marks: dict | None = None, quantity: str = "radius",
-                         speed_unit: str = "rad/s") -> Path:
-    """Draw a :class:`~femmech.analysis.stability.StabilityChart` as a PNG.
+_LOOSE_LABEL = "not converged (value unreliable)"
 
-    With a second parameter: the (speed, parameter) plane with the unstable regions
-    (spectral radius > 1 + tol, parametric resonances) shaded and the boundary drawn.
-    Without: over speed, the spectral radius (log scale, ``quantity="radius"``) or the
-    growth rate ln(max|μ|)/T in 1/s (``quantity="growth_rate"``, where resonances show
-    as bumps at any speed), with unstable speed ranges shaded. ``marks``
-    ({label: speed}) adds labelled vertical lines, e.g. the predicted resonance speeds
-    2ω_k/j, in rad/s like the chart. ``speed_unit`` ("rad/s", "Hz" or "rpm") is the unit
-    of the speed axis; ``speed_label`` overrides its label.
-    """
+
+def _unconverged(chart, shape) -> np.ndarray:
+    """Mask of chart points that missed their tolerance (none for unchecked charts)."""
+    converged = getattr(chart, "converged", None)
+    if converged is None:
+        return np.zeros(shape, dtype=bool)
+    return ~np.asarray(converged, dtype=bool).reshape(shape)
+
+
+def stability_figure(chart, title: str = "Floquet stability", speed_label: str | None = None,
+                     marks: dict | None = None, quantity: str = "radius",
+                     speed_unit: str = "rad/s"):
+    """The matplotlib Figure of :func:`plot_stability_chart` (same arguments)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -96,7 +96,8 @@ def plot_stability_chart(chart, filename, title: str = "Floquet stability",
     scale = scales[speed_unit]
     speed_label = speed_label or f"drive speed ({speed_unit})"
     speeds, radius = scale * np.asarray(chart.speeds), np.asarray(chart.spectral_radius)
-    unstable = ~np.asarray(chart.stable)
+    loose = _unconverged(chart, radius.shape)
+    unstable = ~np.asarray(chart.stable) & ~loose
     if speeds.size < 2 or radius.shape != (radius.shape[0], speeds.size):
         raise ValueError(f"the chart needs >= 2 speeds and radii (n_values, {speeds.size}),"
                          f" got {speeds.size} speeds and radii {radius.shape}")
@@ -107,16 +108,25 @@ def plot_stability_chart(chart, filename, title: str = "Floquet stability",
         raise ValueError(f"quantity must be 'radius' or 'growth_rate', got {quantity!r}")
     if chart.values is None or len(chart.values) < 2:
         if quantity == "radius":
-            ax.semilogy(speeds, np.maximum(radius[0], 1e-300), color="k", lw=1.2)
+            y = np.maximum(radius[0], 1e-300)
+            ax.set_yscale("log")
             ax.axhline(1.0 + chart.tol, color="tab:red", lw=0.8, ls="--")
             ax.set_ylabel("spectral radius max|μ|")
         else:
-            ax.plot(speeds, chart.growth_rate[0], color="k", lw=1.2)
+            y = chart.growth_rate[0]
             ax.axhline(0.0, color="tab:red", lw=0.8, ls="--")
             ax.set_ylabel("growth rate ln(max|μ|)/T (1/s)")
+        ax.plot(speeds, np.where(loose[0], np.nan, y), color="k", lw=1.2)
         edges = np.concatenate([[speeds[0]], 0.5 * (speeds[1:] + speeds[:-1]), [speeds[-1]]])
         for j in np.flatnonzero(unstable[0]):
-            ax.axvspan(edges[j], edges[j + 1], color="tab:red", alpha=0.25, lw=0)
+            ax.axvspan(edges[j], edges[j + 1], color="tab:red", alpha=0.25, lw=0,
+                       label="unstable")
+        for j in np.flatnonzero(loose[0]):
+            ax.axvspan(edges[j], edges[j + 1], facecolor="none", edgecolor="0.45",
+                       hatch="///", lw=0, label=_LOOSE_LABEL)
+        if loose[0].any():
+            finite = np.isfinite(y) & loose[0]
+            ax.plot(speeds[finite], y[finite], ls="none", marker="x", color="0.45", ms=5)
     else:
         values = np.asarray(chart.values)
         if quantity == "growth_rate":
@@ -127,6 +137,10 @@ def plot_stability_chart(chart, filename, title: str = "Floquet stability",
                     colors=["tab:red"], alpha=0.35)
         ax.contour(speeds, values, np.log(np.maximum(radius, 1e-300)),
                    levels=[np.log1p(chart.tol)], colors=["tab:red"], linewidths=0.8)
+        if loose.any():
+            S, V = np.meshgrid(speeds, values)
+            ax.scatter(S[loose], V[loose], marker="s", s=60, facecolor="white",
+                       edgecolor="0.3", hatch="////", lw=0.6, zorder=3, label=_LOOSE_LABEL)
         ax.set_ylabel(chart.parameter_name)
     for label, speed in (marks or {}).items():
         ax.axvline(scale * speed, color="0.3", lw=0.7, ls=":")
@@ -135,7 +149,32 @@ def plot_stability_chart(chart, filename, title: str = "Floquet stability",
                     ha="right", fontsize=7)
     ax.set_xlabel(speed_label)
     ax.set_title(f"{title} (shaded: unstable)")
+    handles, labels = ax.get_legend_handles_labels()
+    if handles:
+        unique = dict(zip(labels, handles, strict=True))
+        ax.legend(unique.values(), unique.keys(), fontsize=7, loc="best")
     fig.tight_layout()
+    return fig
+
+
+def plot_stability_chart(chart, filename, title: str = "Floquet stability",
+                         speed_label: str | None = None,
+                         marks: dict | None = None, quantity: str = "radius",
+                         speed_unit: str = "rad/s") -> Path:
+    """Draw a :class:`~femmech.analysis.stability.StabilityChart` as a PNG.
+
+    With a second parameter: the (speed, parameter) plane with the unstable regions
+    (spectral radius > 1 + tol, parametric resonances) shaded and the boundary drawn.
+    Without: over speed, the spectral radius (log scale, ``quantity="radius"``) or the
+    growth rate ln(max|μ|)/T in 1/s (``quantity="growth_rate"``, where resonances show
+    as bumps at any speed), with unstable speed ranges shaded. Points whose monodromy
+    matrix missed its tolerance (``chart.converged`` False) are hatched grey and drawn
+    as crosses off the curve, never as part of it. ``marks``
+    ({label: speed}) adds labelled vertical lines, e.g. the predicted resonance speeds
+    2ω_k/j, in rad/s like the chart. ``speed_unit`` ("rad/s", "Hz" or "rpm") is the unit
+    of the speed axis; ``speed_label`` overrides its label.
+    """
+    fig = stability_figure(chart, title, speed_label, marks, quantity, speed_unit)
     with atomic_path(filename) as tmp:
         fig.savefig(tmp, format="png")
     return Path(filename)
