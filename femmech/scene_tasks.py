@@ -237,8 +237,10 @@ def run_stability(ws, spec, out):
     flags = ()
     if not ok.all():
         bad = speeds[~ok] * RPM
-        flags = (f"{int((~ok).sum())} of {speeds.size} speeds ({bad.min():.0f}..{bad.max():.0f}"
-                 f" rpm) did NOT converge within max_steps = {spec.max_steps} Magnus steps per"
+        where = (f"{bad.min():.0f} rpm" if bad.size == 1 else
+                 f"{bad.min():.0f}..{bad.max():.0f} rpm")
+        flags = (f"{int((~ok).sum())} of {speeds.size} speeds ({where}) did NOT converge"
+                 f" within max_steps = {spec.max_steps} Magnus steps per"
                  " period: their spectral radius and verdict may be wrong (hatched in the"
                  " chart, converged = 0 in stability.csv). Raise max_steps.",)
         ws.log(f"stability: {flags[0]}")
@@ -248,7 +250,7 @@ def run_stability(ws, spec, out):
                  for W, r, e, c in zip(speeds, radius, error, ok, strict=True))
     section = Section("Stability chart", text, (Table("Spectral radius of the monodromy"
                                                       " matrix", ("speed (rpm)", "max |μ|",
-                                                                  "error estimate",
+                                                                  "error estimate of max |μ|",
                                                                   "stable"), rows),),
                       (Figure("stability_chart.png", "Floquet stability over drive speed"),),
                       ("stability.csv",), warnings=flags)
