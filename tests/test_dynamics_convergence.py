@@ -60,11 +60,12 @@ def test_expm_stack_matches_scipy():
     # Higham's scaling and squaring [13/13] Padé has backward error below the unit
     # round-off; against scipy's (the same algorithm, matrix by matrix, other rounding)
     # the forward difference is bounded by the condition of the exponential, at most
-    # about ‖A‖₁ times eps relative to |e^A|: 50 eps max(1, ‖A‖₁) (measured 1e-12 at
-    # ‖A‖₁ ≈ 1e4, 1e-16 at small norms).
+    # about ‖A‖₁ times eps relative to |e^A|: 50 eps max(1, ‖A‖₁) (measured at most 0.03
+    # of it; up to 14 squarings at ‖A‖₁ ≈ 2e3).
     rng = np.random.default_rng(3)
-    scales = np.array([0.0, 1e-3, 1.0, 30.0, 300.0, 1e3])[:, None, None]
-    A = scales * (rng.standard_normal((6, 9, 9)) / 3.0 - 2.0 * np.eye(9))  # non-normal, decaying
+    G = rng.standard_normal((6, 9, 9)) / 3.0  # non-normal
+    G -= np.linalg.eigvals(G).real.max(axis=1)[:, None, None] * np.eye(9)  # |e^A| ~ 1
+    A = np.array([0.0, 1e-3, 1.0, 30.0, 300.0, 1e3])[:, None, None] * G
     for a, e in zip(A, expm_stack(A), strict=True):
         ref = sla.expm(a)
         bound = 50 * np.finfo(float).eps * max(1.0, np.abs(a).sum(axis=0).max())
