@@ -199,15 +199,8 @@ def assemble_at(system: CoupledSystem, blocks, index: int):
         B = (system.B0 + sum(parts["B"])).tocsr()
         C = (system.K0 + sum(parts["C"])).tocsr()
         return M, B, C, F
-    M, B, C = system.M0.copy(), system.B0.copy(), system.K0.copy()
-    F = np.zeros(system.n)
-    for idx, (Mm, Bm, Cm, Fm) in zip(system.touched, blocks, strict=True):
-        ix = np.ix_(idx, idx)
-        M[ix] += Mm[index]
-        B[ix] += Bm[index]
-        C[ix] += Cm[index]
-        F[idx] += Fm[index]
-    return M, B, C, F
+    one = [tuple(X[index:index + 1] for X in block) for block in blocks]
+    return tuple(X[0] for X in assemble_stack(system, one))
 
 
 def assemble_stack(system: CoupledSystem, blocks):
@@ -216,7 +209,9 @@ def assemble_stack(system: CoupledSystem, blocks):
     The vectorised form of :func:`assemble_at` for reduced frames (time integrators need
     the matrices at many time points).
     """
-    require_dense_primal(system, "assemble_stack")
+    if system.is_sparse:
+        raise ValueError("assemble_stack needs a reduced frame (dense matrices); use"
+                         " assemble_at for an unreduced one")
     k = blocks[0][0].shape[0] if blocks else 1
     M, B, C = (np.repeat(A[None], k, axis=0) for A in (system.M0, system.B0, system.K0))
     F = np.zeros((k, system.n))

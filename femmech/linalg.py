@@ -154,31 +154,35 @@ def residuals(K, M, omega2, vectors, floor: float) -> np.ndarray:
 
     ``floor`` (rad²/s², e.g. ``|σ|``) keeps the measure meaningful for rigid-body modes.
     """
+    num, den = _residual_terms(K, M, omega2, vectors, floor)
+    return num / np.where(den > 0, den, 1.0)
+
+
+def _residual_terms(K, M, omega2, vectors, floor: float):
+    """Numerator ‖K x - λ M x‖ and denominator max(|λ|, floor) ‖M x‖ per column."""
     Kx = K @ vectors
     Mx = M @ vectors
     num = np.linalg.norm(Kx - Mx * omega2, axis=0)
-    den = np.maximum(np.abs(omega2), floor) * np.linalg.norm(Mx, axis=0)
-    return num / np.where(den > 0, den, 1.0)
+    return num, np.maximum(np.abs(omega2), floor) * np.linalg.norm(Mx, axis=0)
 
 
 RESIDUAL_TOL = 1e-6
 """Relative residual above which a computed mode is reported (when round-off allows it)."""
 
 
-def residual_limits(K, M, omega2, vectors, floor: float) -> np.ndarray:
+def residual_limits(K, vectors, den) -> np.ndarray:
     """Per column, the larger of :data:`RESIDUAL_TOL` and the round-off level of a residual.
 
     Forming ``K x`` alone carries an error of about eps ‖K‖∞ ‖x‖ (Higham, Accuracy and
     Stability of Numerical Algorithms, 2002, sect. 3.5), so the relative residual of
-    :func:`residuals` can not fall below ~eps ‖K‖∞ ‖x‖ / (max(|λ|, floor) ‖M x‖) on any
-    BLAS; 100 times that is the limit (the low modes of stiff-contrast pencils and fine
-    slender-beam meshes, eps λ_max / λ_1 ~ 1e-7 … 1e-4, whose residuals otherwise cross
-    a fixed 1e-6 on one BLAS kernel and not on another).
+    :func:`residuals` can not fall below ~eps ‖K‖∞ ‖x‖ / den on any BLAS, with den =
+    max(|λ|, floor) ‖M x‖ its denominator (n_modes,); 100 times that is the limit (the
+    low modes of stiff-contrast pencils and fine slender-beam meshes, eps λ_max / λ_1 ~
+    1e-7 … 1e-4, whose residuals otherwise cross a fixed 1e-6 on one BLAS kernel and
+    not on another).
     """
     k_norm = float(abs(K).sum(axis=1).max()) if K.shape[0] else 0.0
     x_norm = np.linalg.norm(vectors, axis=0)
-    mx_norm = np.linalg.norm(M @ vectors, axis=0)
-    den = np.maximum(np.abs(omega2), floor) * mx_norm
     roundoff = 100 * np.finfo(float).eps * k_norm * x_norm / np.where(den > 0, den, np.inf)
     return np.maximum(RESIDUAL_TOL, roundoff)
 
@@ -801,8 +805,9 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         omega2, X, shift = _sparse_band(K, M, band, sigma, factor)
         method = "arpack"
     X = normalize_modes(X, M)
-    res = residuals(K, M, omega2, X, 1e-6 * scale)
-    limits = residual_limits(K, M, omega2, X, 1e-6 * scale)
+    num, den = _residual_terms(K, M, omega2, X, 1e-6 * scale)
+    res = num / np.where(den > 0, den, 1.0)
+    limits = residual_limits(K, X, den)
     if res.size and (res > limits).any():
         k = int(np.argmax(res / limits))
         warnings.warn(f"eigen solve: relative residual {res[k]:.2e} of mode {k + 1} exceeds"

@@ -218,15 +218,16 @@ def run_stability(ws, spec, out):
                                   rtol=spec.rtol, max_steps=spec.max_steps)
                   for W in progress(speeds, "stability", ws.bars)]
     chart = merge_charts(points, 1, len(points), speeds, None)
-    radius, error = chart.spectral_radius[0], chart.error[0]
+    radius, error, stable = chart.spectral_radius[0], chart.error[0], chart.stable[0]
     ok, steps = chart.converged[0], chart.n_steps[0]
     plot_stability_chart(chart, out / "stability_chart.png", title=ws.scene.name,
                          speed_unit="rpm")
     _write_csv(out / "stability.csv", ["speed_rad_s", "speed_rpm", "spectral_radius",
                                        "error_estimate", "converged", "n_steps", "stable"],
-               [(W, W * RPM, r, e, int(c), n, int(r <= 1 + spec.tol) if c else "")
-                for W, r, e, c, n in zip(speeds, radius, error, ok, steps, strict=True)])
-    unstable = speeds[(radius > 1 + spec.tol) & ok]
+               [(W, W * RPM, r, e, int(c), n, int(s) if c else "")
+                for W, r, e, c, n, s in zip(speeds, radius, error, ok, steps, stable,
+                                            strict=True)])
+    unstable = speeds[~stable & ok]
     text = (f"{speeds.size} speeds from {speeds[0] * RPM:.0f} to {speeds[-1] * RPM:.0f} rpm;"
             f" Rayleigh damping (mass, stiffness) = {spec.rayleigh}. Magnus steps per period"
             f" doubled from {spec.n_steps} until the spectral radius changed by at most"
@@ -244,10 +245,10 @@ def run_stability(ws, spec, out):
                  " period: their spectral radius and verdict may be wrong (hatched in the"
                  " chart, converged = 0 in stability.csv). Raise max_steps.",)
         ws.log(f"stability: {flags[0]}")
-    rows = tuple((float(W * RPM), float(r), f"{e:.1e}", "yes" if r <= 1 + spec.tol else "no")
+    rows = tuple((float(W * RPM), float(r), f"{e:.1e}", "yes" if s else "no")
                  if c else (float(W * RPM), Flagged(f"{r:.6g} NOT CONVERGED"), f"{e:.1e}",
                             Flagged("unknown"))
-                 for W, r, e, c in zip(speeds, radius, error, ok, strict=True))
+                 for W, r, e, c, s in zip(speeds, radius, error, ok, stable, strict=True))
     section = Section("Stability chart", text, (Table("Spectral radius of the monodromy"
                                                       " matrix", ("speed (rpm)", "max |μ|",
                                                                   "error estimate of max |μ|",

@@ -330,21 +330,23 @@ def periodic_steady_state(system, Omega: float, n_steps: int = 512, rho_inf: flo
     solutions = [solve(n_steps)]
     if richardson:
         solutions.append(solve(2 * n_steps))
+
+    def level():  # the result from the newest solution(s)
+        return _extrapolated(*solutions[-2:]) if richardson else solutions[-1]
+
+    levels = [level()]
     if rtol is None:
-        result = _extrapolated(*solutions) if richardson else solutions[0]
-        return replace(result, n_steps=2 * n_steps if richardson else n_steps)
+        return replace(levels[0], n_steps=2 * n_steps if richardson else n_steps)
     mass = _matrices(system, *ConstantSpeed(Omega, phi0)(np.zeros(1)))(0)[0]
     error, converged = np.inf, False
     while 2 * (n := n_steps * 2 ** (len(solutions) - 1)) <= max_steps:
         solutions.append(solve(2 * n))
-        levels = solutions if not richardson else \
-            [_extrapolated(a, b) for a, b in zip(solutions, solutions[1:], strict=False)]
-        if len(levels) >= 2:
-            error = _change(levels[-2], levels[-1], mass)
-            if error <= rtol:
-                converged = True
-                break
-    finest = _extrapolated(*solutions[-2:]) if richardson else solutions[-1]
+        levels.append(level())
+        error = _change(levels[-2], levels[-1], mass)
+        if error <= rtol:
+            converged = True
+            break
+    finest = levels[-1]
     every = (finest.t.size - 1) // n_steps
     result = Response(finest.t[::every], finest.q[::every], finest.v[::every],
                       finest.a[::every], finest.phi[::every], float(error), converged,

@@ -75,14 +75,6 @@ def write_sweep_json(sweep, filename, metadata: dict | None = None) -> Path:
 _LOOSE_LABEL = "not converged (value unreliable)"
 
 
-def _unconverged(chart, shape) -> np.ndarray:
-    """Mask of chart points that missed their tolerance (none for unchecked charts)."""
-    converged = getattr(chart, "converged", None)
-    if converged is None:
-        return np.zeros(shape, dtype=bool)
-    return ~np.asarray(converged, dtype=bool).reshape(shape)
-
-
 def stability_figure(chart, title: str = "Floquet stability", speed_label: str | None = None,
                      marks: dict | None = None, quantity: str = "radius",
                      speed_unit: str = "rad/s"):
@@ -96,7 +88,7 @@ def stability_figure(chart, title: str = "Floquet stability", speed_label: str |
     scale = scales[speed_unit]
     speed_label = speed_label or f"drive speed ({speed_unit})"
     speeds, radius = scale * np.asarray(chart.speeds), np.asarray(chart.spectral_radius)
-    loose = _unconverged(chart, radius.shape)
+    loose = chart.unconverged.reshape(radius.shape)
     unstable = ~np.asarray(chart.stable) & ~loose
     if speeds.size < 2 or radius.shape != (radius.shape[0], speeds.size):
         raise ValueError(f"the chart needs >= 2 speeds and radii (n_values, {speeds.size}),"
