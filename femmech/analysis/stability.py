@@ -77,8 +77,8 @@ _CHUNK_BYTES = 2**25
 
 RTOL = 1e-4
 """Default tolerance on the spectral radius of a monodromy matrix (relative). The
-estimate is conservative: on the press example (10 to 3000 rpm) the true error was 1/10
-to 1/60 of it (docs/robustness.md)."""
+estimate is conservative: on the press example (10 to 3000 rpm) the true error was 1/8
+to 1/70 of it (docs/robustness.md)."""
 
 MAX_STEPS = 2**14
 """Default cap on the Magnus steps per period of the step-doubling loop (the press
