@@ -6,7 +6,16 @@ Importing femmech has no side effects and does not import pyvista (see
 
 from femmech.analysis.modes import ModeSet, modes
 from femmech.constraints import InterpolatingLink, RigidLink, Support
-from femmech.errors import ConvergenceWarning, FemmechWarning, ModelWarning
+from femmech.errors import (
+    ConvergenceWarning,
+    FemmechWarning,
+    FileFormatError,
+    InputError,
+    ModelWarning,
+    NumericalError,
+    SceneError,
+    UserCodeError,
+)
 from femmech.io import read_mesh
 from femmech.lumped import PointMass, Spring
 from femmech.materials import Material
@@ -30,19 +39,24 @@ __all__ = [
     "FEModel",
     "ConvergenceWarning",
     "FemmechWarning",
+    "FileFormatError",
+    "InputError",
     "InterpolatingLink",
     "Material",
     "Mesh",
     "ModelWarning",
     "ModeSet",
+    "NumericalError",
     "PointMass",
     "RigidLink",
+    "SceneError",
     "ShellProperty",
     "ShellSet",
     "SolidProperty",
     "SolidSet",
     "Spring",
     "Support",
+    "UserCodeError",
     "build_model",
     "modes",
     "read_mesh",

@@ -1,13 +1,40 @@
-"""Warning class of femmech (errors are plain ``ValueError``/``TypeError``)."""
+"""Exceptions and warnings of femmech.
+
+Errors a user can fix (a scene, a mesh, a superelement or cache file, a command-line value,
+a scene's own Python code) derive from :class:`InputError`; a computation that ran on valid
+input but failed is a :class:`NumericalError`. Both derive from the builtin classes code
+already catches (``ValueError``, ``RuntimeError``). The command line maps them to its
+documented exit codes (:mod:`femmech.cli`).
+"""
 
 
 class FemmechWarning(UserWarning):
     """A result was computed but deserves the user's attention (e.g. poor convergence)."""
 
 
-class SceneError(ValueError):
+class InputError(ValueError):
+    """A user input is invalid; the one-line message names the file and the item (key,
+    field, node, element, group or parameter) and what was expected."""
+
+
+class SceneError(InputError):
     """A scene file is invalid; the one-line message names the file, the key and what was
     expected (``scene.toml: [parts.frame.sections.posts] section: expected one of ...``)."""
+
+
+class FileFormatError(InputError):
+    """A data file (superelement, cache entry, mesh) is damaged, foreign or inconsistent;
+    the one-line message names the file and the field (``frame.npz: field 'K': not
+    symmetric``). Such files are never executed (no pickle)."""
+
+
+class UserCodeError(InputError):
+    """Python code named by a scene (``module =``) was refused (no opt-in, a path outside
+    the allowed root) or failed when run (an exception or ``sys.exit``)."""
+
+
+class NumericalError(RuntimeError):
+    """A computation on valid input failed (no convergence, a singular matrix)."""
 
 
 class ModelWarning(FemmechWarning):
