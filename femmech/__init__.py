@@ -7,6 +7,7 @@ Importing femmech has no side effects and does not import pyvista (see
 from femmech.analysis.modes import ModeSet, modes
 from femmech.constraints import InterpolatingLink, RigidLink, Support
 from femmech.errors import (
+    CacheWarning,
     ConvergenceWarning,
     FemmechWarning,
     FileFormatError,
@@ -36,6 +37,7 @@ __version__ = "0.1.0"
 __all__ = [
     "BeamProperty",
     "BeamSection",
+    "CacheWarning",
     "FEModel",
     "ConvergenceWarning",
     "FemmechWarning",

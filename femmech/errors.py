@@ -28,7 +28,7 @@ class FileFormatError(InputError):
     symmetric``). Such files are never executed (no pickle)."""
 
 
-class UserCodeError(InputError):
+class UserCodeError(SceneError):
     """Python code named by a scene (``module =``) was refused (no opt-in, a path outside
     the allowed root) or failed when run (an exception or ``sys.exit``)."""
 
@@ -41,6 +41,11 @@ class ModelWarning(FemmechWarning):
     """A model input looks wrong (nearly coincident nodes, a free body by accident, a unit
     mix-up): the results are computed but are probably not those of the intended model.
     See :mod:`femmech.checks`."""
+
+
+class CacheWarning(FemmechWarning):
+    """The reduction cache could not be read or written (read-only or full folder, a
+    corrupt or foreign entry); the result was recomputed and is unaffected."""
 
 
 class ConvergenceWarning(FemmechWarning):
