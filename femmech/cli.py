@@ -1,54 +1,105 @@
-"""Command line: ``femmech run SCENE --out DIR`` and ``femmech check SCENE``.
+"""Command line: ``femmech run SCENE --out DIR``, ``femmech check SCENE`` and
+``femmech cache info|clear``.
 
-Exit codes: 0 success, 1 a computation failed, 2 an invalid scene or command line (the
-error is one line on stderr naming the file, the key and what was expected). Suspicious
-inputs (nearly coincident nodes, loose parts, unit mix-ups: :mod:`femmech.checks`) are
-reported, not refused: one ``warning:`` line each on stdout and in the run's log.
+Exit codes (:data:`EXIT_CODES`):
+
+====  ===================================================================================
+0     success (``check``: the scene is valid)
+1     internal error: an unexpected exception, i.e. a bug in femmech (one line; the
+      traceback with ``--debug``)
+2     usage error: the command line is invalid (argparse)
+3     input error: a scene, mesh, superelement or cache file is invalid, or the scene's
+      Python code was refused or failed (one line naming the file and the item)
+4     numerical failure: a computation on valid input failed (naming the analysis)
+5     file-system error: a file or folder could not be read or written (permission, full
+      disk)
+130   interrupted (Ctrl-C)
+====  ===================================================================================
+
+Errors are one line on stderr, no traceback unless ``--debug``. Suspicious inputs
+(nearly coincident nodes, loose parts, unit mix-ups: :mod:`femmech.checks`) are reported,
+not refused: one ``warning:`` line each on stdout and in the run's log.
+
+Scene files are data: ``run`` executes Python code a scene names (``module =``) only with
+``--allow-code``, and only from the scene's folder (or ``--code-root``); ``check`` never
+runs it.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import traceback
 from pathlib import Path
 
-from femmech.errors import SceneError
+from femmech.errors import InputError, NumericalError
+
+OK, INTERNAL, USAGE, INPUT, NUMERICAL, FILESYSTEM, INTERRUPTED = 0, 1, 2, 3, 4, 5, 130
+EXIT_CODES = {OK: "success", INTERNAL: "internal error (a bug: rerun with --debug, report it)",
+              USAGE: "usage error (command line)", INPUT: "input error (scene, mesh, file,"
+              " scene code)", NUMERICAL: "numerical failure", FILESYSTEM: "file-system error",
+              INTERRUPTED: "interrupted"}
+"""Exit code → meaning."""
 
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="femmech", description="Machines described in scene files (TOML): compute the"
-        " requested analyses with cached reductions and write an HTML report.")
+        " requested analyses with cached reductions and write an HTML report.",
+        epilog="exit codes: " + "; ".join(f"{k} {v}" for k, v in EXIT_CODES.items()))
+    parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="compute a scene and write its report")
     run.add_argument("scene", type=Path, help="scene file (.toml)")
-    run.add_argument("--out", type=Path, required=True, help="output folder (created)")
+    run.add_argument("--out", type=Path, required=True, help="output folder (created; an"
+                     " existing one must be empty or hold an earlier run, which is replaced)")
     run.add_argument("--no-cache", action="store_true", help="do not read or write the"
                      " reduction cache")
     run.add_argument("--cache-dir", type=Path, default=None,
                      help="reduction cache folder (default: $FEMMECH_CACHE_DIR, else"
                      " ~/.cache/femmech)")
+    _code_options(run, "run the Python modules the scene names (module = ...); only for"
+                  " scenes from authors you trust")
     run.add_argument("-q", "--quiet", action="store_true", help="no log lines, no progress"
                      " bars")
-    check = sub.add_parser("check", help="validate a scene without computing")
+    run.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                     help="show the traceback of an error")
+    check = sub.add_parser("check", help="validate a scene without computing (never runs"
+                           " the scene's Python code)")
     check.add_argument("scene", type=Path, help="scene file (.toml)")
+    check.add_argument("--code-root", type=Path, default=None, help="folder the scene's"
+                       " Python modules may lie in (default: the scene's folder)")
+    check.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                       help="show the traceback of an error")
     return parser
 
 
-def _check(path: Path) -> int:
+def _code_options(parser, help_allow: str) -> None:
+    parser.add_argument("--allow-code", action="store_true", help=help_allow)
+    parser.add_argument("--code-root", type=Path, default=None, help="folder the scene's"
+                        " Python modules may lie in (default: the scene's folder)")
+
+
+def _check(args) -> int:
     from femmech.scene import load_scene
     from femmech.scene_build import finding_lines, prepare
 
-    prepared = prepare(load_scene(path))
+    path = args.scene
+    prepared = prepare(load_scene(path), code_root=args.code_root, run_code=False)
     scene = prepared.scene
     parts = ", ".join(f"{n} ({m.n_nodes} nodes)" for n, m in prepared.meshes.items())
     analyses = [k for k in ("modes", "sweep", "stability", "response", "check")
                 if getattr(scene.analyses, k) is not None]
     print(f"{path.name}: OK: parts {parts or '-'}; mechanisms {list(scene.mechanisms) or '-'};"
           f" mounts {len(scene.mounts)}; analyses {analyses}")
+    for name in prepared.unexecuted:
+        spec = scene.mechanisms[name]
+        print(f"{path.name}: note: [{spec.where}] module {Path(spec.module).name}: user code,"
+              " not executed (check never runs it; its coordinate names are unchecked;"
+              " 'femmech run --allow-code' runs it)")
     for line in finding_lines(prepared):  # suspicious inputs: reported, not refused
         print(f"{path.name}: {line}")
-    return 0
+    return OK
 
 
 def _run(args) -> int:
@@ -58,24 +109,58 @@ def _run(args) -> int:
     cache = None if args.no_cache else (args.cache_dir or default_cache_dir())
     bars = not args.quiet and sys.stderr.isatty()
     result = run_scene(args.scene, args.out, cache_dir=cache,
-                       log=None if args.quiet else print, bars=bars)
+                       log=None if args.quiet else print, bars=bars,
+                       allow_code=args.allow_code, code_root=args.code_root)
     if args.quiet:
         print(result.report)
-    return 0
+    return OK
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split("\n")).strip() or type(exc).__name__
 
 
 def main(argv=None) -> int:
-    """Entry point of the ``femmech`` command; returns the exit code."""
+    """Entry point of the ``femmech`` command; returns the exit code (:data:`EXIT_CODES`)."""
     args = _parser().parse_args(argv)
+    command = {"check": _check, "run": _run}[args.command]
     try:
-        return _check(args.scene) if args.command == "check" else _run(args)
-    except SceneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except (ValueError, RuntimeError, OSError) as exc:
-        print(f"error: {args.scene.name}: {type(exc).__name__}: {exc}".replace("\n", " "),
-              file=sys.stderr)
-        return 1
+        return command(args)
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return INTERRUPTED
+    except Exception as exc:  # noqa: BLE001 - every error ends as one line and a code
+        code = exit_code(exc)
+        if args.debug:
+            traceback.print_exc()
+        name = args.scene.name
+        if code == INPUT:
+            text = _one_line(exc)
+            message = f"error: {text}" if text.startswith(name) else f"error: {name}: {text}"
+        elif code == NUMERICAL:
+            message = f"numerical failure: {_one_line(exc)}"
+        elif code == FILESYSTEM:
+            message = f"error: {name}: cannot read or write a file: {_one_line(exc)}"
+        else:
+            message = (f"internal error: {type(exc).__name__}: {_one_line(exc)} (a bug in"
+                       " femmech; rerun with --debug for the traceback and report it)")
+        print(message, file=sys.stderr)
+        return code
+
+
+def exit_code(exc: BaseException) -> int:
+    """The exit code of an exception (see :data:`EXIT_CODES`)."""
+    import numpy as np
+
+    if isinstance(exc, InputError):
+        return INPUT
+    if isinstance(exc, NumericalError | np.linalg.LinAlgError):
+        return NUMERICAL
+    if isinstance(exc, FileNotFoundError | IsADirectoryError | NotADirectoryError):
+        return INPUT  # a path the user gave does not exist or is of the wrong kind
+    if isinstance(exc, OSError):
+        return FILESYSTEM
+    return INTERNAL
 
 
 if __name__ == "__main__":

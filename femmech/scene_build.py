@@ -26,7 +26,7 @@ import femmech as fm
 from femmech import sections as sec
 from femmech.coupling import Attachment, Mount
 from femmech.dofs import COMPONENTS
-from femmech.errors import ModelWarning, SceneError
+from femmech.errors import ModelWarning, SceneError, UserCodeError
 from femmech.generators import grid_frame, members_frame
 from femmech.model import model_findings, node_index, node_indices
 from femmech.reduction import FORMAT_VERSION, craig_bampton, guyan
@@ -52,6 +52,9 @@ class Prepared:
         :func:`reduction_key_data`).
     findings : dict[str, tuple of femmech.checks.Finding]
         Per part: suspicious inputs (:func:`part_findings`).
+    unexecuted : tuple of str
+        Mechanisms from user modules that were not built (``prepare(run_code=False)``);
+        absent from ``mechanisms``.
     """
 
     scene: Scene
@@ -59,6 +62,7 @@ class Prepared:
     mechanisms: dict
     keys: dict
     findings: dict = field(default_factory=dict)
+    unexecuted: tuple = ()
 
 
 def fail(scene: Scene, where: str, key: str | None, message: str) -> SceneError:
@@ -67,22 +71,51 @@ def fail(scene: Scene, where: str, key: str | None, message: str) -> SceneError:
     return SceneError(f"{scene.file}: {place}: {message}".replace("\n", " "))
 
 
-def prepare(scene: Scene) -> Prepared:
-    """Read/generate meshes and build mechanisms; check all references (no FE assembly)."""
-    from femmech.scene_mechanisms import mechanism_model
+def prepare(scene: Scene, allow_code: bool = False, code_root=None,
+            run_code: bool = True) -> Prepared:
+    """Read/generate meshes and build mechanisms; check all references (no FE assembly).
+
+    Parameters
+    ----------
+    scene : Scene
+    allow_code : bool
+        Run the Python modules a scene names (``module =``). Without this opt-in such a
+        scene is refused (:class:`~femmech.errors.UserCodeError`): a scene file is data,
+        its code runs only for a user who trusts its author.
+    code_root : path, optional
+        Folder user modules must lie in (default: the scene's folder).
+    run_code : bool
+        False (what ``femmech check`` does): never run user code, whatever ``allow_code``
+        says; its module paths are checked, its mechanisms are listed in
+        :attr:`Prepared.unexecuted` and the checks that need their coordinates are skipped.
+    """
+    from femmech.scene_mechanisms import confined_module, mechanism_model
 
     meshes = {name: part_mesh(scene, part) for name, part in scene.parts.items()}
     for name, part in scene.parts.items():
         check_part(scene, part, meshes[name])
-    models = {name: mechanism_model(scene, spec) for name, spec in scene.mechanisms.items()}
+    coded = [spec for spec in scene.mechanisms.values() if spec.module is not None]
+    for spec in coded:
+        confined_module(scene, spec, code_root)
+    if coded and run_code and not allow_code:
+        spec = coded[0]
+        raise UserCodeError(str(fail(
+            scene, spec.where, "module", f"{Path(spec.module).name} is Python code; femmech"
+            " runs code named by a scene only with --allow-code (API: allow_code=True). Allow"
+            " it only for scenes from authors you trust; 'femmech check' never runs it")))
+    models = {name: mechanism_model(scene, spec, code_root)
+              for name, spec in scene.mechanisms.items()
+              if run_code or spec.module is None}
     for mount in scene.mounts:
-        _check_mount(scene, mount, meshes[mount.part], models[mount.mechanism])
-    _check_outputs(scene, models)
+        _check_mount(scene, mount, meshes[mount.part], models.get(mount.mechanism))
+    if len(models) == len(scene.mechanisms):
+        _check_outputs(scene, models)
     keys = {name: sha256_key(reduction_key_data(scene, part))
             for name, part in scene.parts.items() if part.reduction is not None}
     findings = {name: part_findings(scene, part, meshes[name])
                 for name, part in scene.parts.items()}
-    return Prepared(scene, meshes, models, keys, findings)
+    unexecuted = tuple(name for name in scene.mechanisms if name not in models)
+    return Prepared(scene, meshes, models, keys, findings, unexecuted)
 
 
 def finding_lines(prepared: Prepared) -> list[str]:
@@ -209,9 +242,11 @@ def _resolve(scene, mesh, ref, where, key, one: bool):
 
 
 def _check_mount(scene, mount, mesh, model) -> None:
-    names = model.coordinate_names
+    """Attachment coordinates (unless ``model`` is None: user code not run), nodes and
+    directions of a mount."""
     for att in mount.attachments:
-        if att.coordinate not in names:
+        if model is not None and att.coordinate not in model.coordinate_names:
+            names = model.coordinate_names
             raise fail(scene, att.where, "coordinate", f"expected one of the coordinates"
                        f" {list(names)} of mechanism {mount.mechanism!r}, got"
                        f" {att.coordinate!r}")

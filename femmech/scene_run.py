@@ -4,11 +4,10 @@
 :class:`Workshop` (an explicit memo kept for one run): a part's FE model is assembled only
 when an analysis or a cache miss needs it, its reduction is loaded from the cache when
 the key matches (:mod:`femmech.cache`), and the unreduced coupled machine is built only
-for the full-versus-reduced check. Results go to ``out``: the report page
-(``report.html``, written last and removed at the start, so a report always describes
-one complete run), ``results.json`` (key numbers, no timings: identical for identical
-inputs), ``run.log`` and the files of each analysis.
-"""
+for the full-versus-reduced check. Results go to ``out``, which a run replaces as a whole
+when it succeeds (:mod:`femmech.output.folder`): the report page (``report.html``),
+``results.json`` (key numbers, no timings: identical for identical inputs), ``run.log``
+and the files of each analysis."""
 
 from __future__ import annotations
 
@@ -21,10 +20,12 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 import femmech as fm
 from femmech.cache import cached_reduction, default_cache_dir
 from femmech.coupling import couple
-from femmech.errors import ModelWarning, SceneError
+from femmech.errors import CacheWarning, ModelWarning, NumericalError, SceneError
 from femmech.output.export import atomic_path
 from femmech.report import Section, Table, write_report
 from femmech.scene import Scene, load_scene
@@ -164,20 +165,31 @@ def _key(scene: Scene, spec, f_max_hz: float) -> str:
 
 
 def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None = None,
-              bars: bool = False) -> RunResult:
+              bars: bool = False, allow_code: bool = False, code_root=None) -> RunResult:
     """Compute the analyses of ``scene`` (a Scene or a scene file) and write the report.
+
+    All files are written into a staging folder that replaces ``out`` only when the run
+    has succeeded (:func:`femmech.output.folder.staged_output`): the report, images and
+    tables in ``out`` always belong to one complete run, and a failed run leaves the
+    previous one as it was.
 
     Parameters
     ----------
     scene : Scene or path
     out : path
-        Output folder (created).
+        Output folder: created (with its parents) if missing; an existing one must be
+        empty or written by an earlier run (InputError otherwise).
     cache_dir : path or None
         Reduction cache; default :func:`femmech.cache.default_cache_dir`, None: no cache.
     log : callable, optional
         Also receives each log line as it happens (e.g. ``print``).
     bars : bool
         tqdm progress bars for the long steps.
+    allow_code : bool
+        Run the Python modules the scene names (``module =``); refused otherwise. Only for
+        scenes from authors you trust (threat model: docs/robustness.md).
+    code_root : path, optional
+        Folder the scene's modules must lie in (default: the scene's folder).
 
     Returns
     -------
@@ -186,14 +198,15 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
     Raises
     ------
     SceneError
-        For an invalid scene (one line naming the file, key and expectation).
+        For an invalid scene (one line naming the file, key and expectation); its
+        subclass UserCodeError for refused or failing scene code.
+    NumericalError
+        When a computation on a valid scene fails (naming the analysis).
     """
+    from femmech.output.folder import staged_output
     from femmech.scene_tasks import TASKS, summary_section
 
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "report.html").unlink(missing_ok=True)
     lines: list[str] = []
 
     def emit(line: str) -> None:
@@ -203,50 +216,70 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
 
     cache = default_cache_dir() if cache_dir is DEFAULT else cache_dir
     start = time.perf_counter()
-    prepared = prepare(scene)
-    ws = Workshop(prepared, cache, emit, bars)
-    ws.timings["prepare"] = time.perf_counter() - start
-    for line in finding_lines(prepared):
-        emit(line)
-    sections, results = [], {}
-    requested = [k for k in TASKS if getattr(scene.analyses, k) is not None]
-    for kind in progress(requested, "analyses", bars):
-        with ws.timed(f"analysis {kind}"), logged_warnings(emit, f"analysis {kind}"):
-            try:
-                section, numbers = TASKS[kind](ws, getattr(scene.analyses, kind), out)
-            except SceneError:
-                raise
-            except ValueError as exc:  # e.g. more modes than coordinates: name the analysis
-                raise fail(scene, scene.analyses.where[kind], None, str(exc)) from None
-        sections.append(section)
-        results[kind] = numbers
-        emit(f"{kind}: done in {ws.timings[f'analysis {kind}']:.2f} s")
-    ws.timings["total"] = time.perf_counter() - start
-    sections.insert(0, summary_section(ws))
-    _write_json(out / "results.json", results)
-    sections.append(Section("Files", files=("results.json", "run.log")))
-    emit(f"report: {out / 'report.html'}")
-    with atomic_path(out / "run.log") as tmp:
-        tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    meta = (f"scene {scene.file} · femmech {fm.__version__} · {time.strftime('%Y-%m-%d %H:%M')}"
-            f" · {ws.timings['total']:.1f} s")
-    title = scene.name + (f" — {scene.description}" if scene.description else "")
-    report = write_report(out, title, meta, sections, lines)
-    return RunResult(out, report, results, tuple(lines), dict(ws.timings))
+    prepared = prepare(scene, allow_code=allow_code, code_root=code_root)
+    with staged_output(out) as stage:
+        final = Path(out).expanduser().absolute()
+        ws = Workshop(prepared, cache, emit, bars)
+        ws.timings["prepare"] = time.perf_counter() - start
+        for line in finding_lines(prepared):
+            emit(line)
+        sections, results = [], {}
+        requested = [k for k in TASKS if getattr(scene.analyses, k) is not None]
+        for kind in progress(requested, "analyses", bars):
+            with ws.timed(f"analysis {kind}"), logged_warnings(emit, f"analysis {kind}"):
+                section, numbers = _analysis(ws, kind, stage)
+            sections.append(section)
+            results[kind] = numbers
+            emit(f"{kind}: done in {ws.timings[f'analysis {kind}']:.2f} s")
+        ws.timings["total"] = time.perf_counter() - start
+        sections.insert(0, summary_section(ws))
+        _write_json(stage / "results.json", results)
+        sections.append(Section("Files", files=("results.json", "run.log")))
+        emit(f"report: {final / 'report.html'}")
+        with atomic_path(stage / "run.log") as tmp:
+            tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        meta = (f"scene {scene.file} · femmech {fm.__version__} ·"
+                f" {time.strftime('%Y-%m-%d %H:%M')} · {ws.timings['total']:.1f} s")
+        title = scene.name + (f" — {scene.description}" if scene.description else "")
+        report = write_report(stage, title, meta, sections, lines)
+    return RunResult(final, final / report.name, results, tuple(lines), dict(ws.timings))
+
+
+NUMERICAL_FAILURES = (RuntimeError, np.linalg.LinAlgError, FloatingPointError, ArithmeticError)
+"""Exceptions of a computation on valid input; reported as NumericalError."""
+
+
+def _analysis(ws: Workshop, kind: str, out: Path):
+    """Run one analysis task; its errors named at ``[analyses.<kind>]``."""
+    from femmech.scene_tasks import TASKS
+
+    scene = ws.scene
+    try:
+        return TASKS[kind](ws, getattr(scene.analyses, kind), out)
+    except (SceneError, NumericalError):
+        raise
+    except NUMERICAL_FAILURES as exc:  # valid input, failed computation
+        where = scene.analyses.where[kind]
+        raise NumericalError(f"{scene.file}: [{where}]: the computation failed:"
+                             f" {type(exc).__name__}: {exc}".replace("\n", " ")) from exc
+    except ValueError as exc:  # e.g. more modes than coordinates: name the analysis
+        raise fail(scene, scene.analyses.where[kind], None, str(exc)) from None
 
 
 @contextmanager
 def logged_warnings(emit: Callable[[str], None], step: str):
-    """:class:`~femmech.errors.ModelWarning` s raised inside go to the run log as
-    ``warning: <step>: <message>``; other warnings pass on unchanged."""
+    """:class:`~femmech.errors.ModelWarning` s and :class:`~femmech.errors.CacheWarning` s
+    raised inside go to the run log as ``warning: <step>: <message>``; other warnings pass
+    on unchanged."""
     caught = []
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ModelWarning)
+            warnings.simplefilter("always", CacheWarning)
             yield
     finally:
         for w in caught:
-            if issubclass(w.category, ModelWarning):
+            if issubclass(w.category, (ModelWarning, CacheWarning)):
                 emit(f"warning: {step}: {w.message}")
             else:
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)

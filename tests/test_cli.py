@@ -1,4 +1,4 @@
-"""The ``femmech`` command: ``run`` and ``check``, exit codes and one-line errors (issue 8)."""
+"""The ``femmech`` command: ``run`` and ``check``, exit codes and one-line errors."""
 
 import subprocess
 import sys
@@ -66,8 +66,8 @@ def test_check_valid_scene(scene, capsys):
     assert "analyses ['modes']" in out
 
 
-def test_check_bad_scene_exit_2_with_one_line(bad_scene, capsys):
-    assert main(["check", str(bad_scene)]) == 2
+def test_check_bad_scene_exit_3_with_one_line(bad_scene, capsys):
+    assert main(["check", str(bad_scene)]) == 3
     err = capsys.readouterr().err
     assert err.count("\n") == 1
     assert err.startswith("error: bad.toml: [parts.frame.supports[0]] fixed: unknown key;"
@@ -75,12 +75,12 @@ def test_check_bad_scene_exit_2_with_one_line(bad_scene, capsys):
 
 
 def test_check_missing_scene(tmp_path, capsys):
-    assert main(["check", str(tmp_path / "nowhere.toml")]) == 2
+    assert main(["check", str(tmp_path / "nowhere.toml")]) == 3
     assert "nowhere.toml: scene file not found" in capsys.readouterr().err
 
 
-def test_run_bad_scene_exit_2(bad_scene, tmp_path, capsys):
-    assert main(["run", str(bad_scene), "--out", str(tmp_path / "out"), "--no-cache"]) == 2
+def test_run_bad_scene_exit_3(bad_scene, tmp_path, capsys):
+    assert main(["run", str(bad_scene), "--out", str(tmp_path / "out"), "--no-cache"]) == 3
     assert "unknown key" in capsys.readouterr().err
     assert not (tmp_path / "out" / "report.html").exists()
 
@@ -117,6 +117,6 @@ def test_module_entry_point_exit_codes(scene, bad_scene):
     assert ok.returncode == 0, ok.stderr
     bad = subprocess.run([sys.executable, "-m", "femmech", "check", str(bad_scene)], cwd=ROOT,
                          capture_output=True, text=True, timeout=120, check=False)
-    assert bad.returncode == 2
+    assert bad.returncode == 3
     assert bad.stderr.count("\n") == 1
     assert bad.stderr.startswith("error: bad.toml: ")
