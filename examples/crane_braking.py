@@ -283,6 +283,7 @@ def swing_amplitude(run: CraneRun, after: float) -> float:
 def main(out_dir=".") -> dict:
     """Run the three braking times, write PNG and CSV; return the key numbers."""
     out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
     runs = {tb: simulate(tb) for tb in BRAKE_TIMES}
     first = runs[BRAKE_TIMES[0]]
     q4_end = {tb: float(r.q[-1, 3]) for tb, r in runs.items()}

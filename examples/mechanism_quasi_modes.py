@@ -59,6 +59,7 @@ def main(out_dir="out") -> dict:
         ``at_speed_max_shift`` the largest relative change of a frequency caused by the
         kinematic terms at 1200 rpm; ``plot`` the PNG path.
     """
+    Path(out_dir).mkdir(parents=True, exist_ok=True)
     p = processing_machine_parameters(kinematic_drive=True)
     model = rheolinear(processing_machine(kinematic_drive=True), p, processing_machine_cams())
     phi = np.deg2rad(np.linspace(0.0, 360.0, 721))

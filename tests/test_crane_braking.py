@@ -118,7 +118,7 @@ def test_braking_swing_and_force(runs):
 
 
 def test_main_writes_outputs(tmp_path, runs):
-    result = cb.main(tmp_path)
+    result = cb.main(tmp_path / "new" / "folder")  # a missing output folder is created
     assert result["png"].stat().st_size > 10_000
     data = np.loadtxt(result["csv"], delimiter=",", skiprows=1)
     assert data.shape[1] == 6 * len(cb.BRAKE_TIMES)
