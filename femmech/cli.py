@@ -1,5 +1,5 @@
 """Command line: ``femmech run SCENE --out DIR``, ``femmech check SCENE`` and
-``femmech cache info|clear``.
+``femmech cache info|clear [--cache-dir DIR]``.
 
 Exit codes (:data:`EXIT_CODES`):
 
@@ -71,6 +71,13 @@ def _parser() -> argparse.ArgumentParser:
                        " Python modules may lie in (default: the scene's folder)")
     check.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                        help="show the traceback of an error")
+    cache = sub.add_parser("cache", help="show or empty the reduction cache")
+    cache.add_argument("action", choices=("info", "clear"), help="info: entries, size, limit"
+                       " and last use; clear: remove femmech's entries (other files stay)")
+    cache.add_argument("--cache-dir", type=Path, default=None,
+                       help="cache folder (default: $FEMMECH_CACHE_DIR, else ~/.cache/femmech)")
+    cache.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                       help="show the traceback of an error")
     return parser
 
 
@@ -116,6 +123,17 @@ def _run(args) -> int:
     return OK
 
 
+def _cache(args) -> int:
+    from femmech.cache import cache_info, clear_cache, default_cache_dir, format_cache_info
+
+    folder = args.cache_dir or default_cache_dir()
+    if args.action == "clear":
+        print(f"removed {clear_cache(folder)} files from {folder}")
+    else:
+        print(format_cache_info(cache_info(folder)))
+    return OK
+
+
 def _one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split("\n")).strip() or type(exc).__name__
 
@@ -123,7 +141,7 @@ def _one_line(exc: BaseException) -> str:
 def main(argv=None) -> int:
     """Entry point of the ``femmech`` command; returns the exit code (:data:`EXIT_CODES`)."""
     args = _parser().parse_args(argv)
-    command = {"check": _check, "run": _run}[args.command]
+    command = {"check": _check, "run": _run, "cache": _cache}[args.command]
     try:
         return command(args)
     except KeyboardInterrupt:
@@ -133,7 +151,7 @@ def main(argv=None) -> int:
         code = exit_code(exc)
         if args.debug:
             traceback.print_exc()
-        name = args.scene.name
+        name = args.scene.name if args.command != "cache" else "cache"
         if code == INPUT:
             text = _one_line(exc)
             message = f"error: {text}" if text.startswith(name) else f"error: {name}: {text}"

@@ -120,3 +120,18 @@ def test_module_entry_point_exit_codes(scene, bad_scene):
     assert bad.returncode == 3
     assert bad.stderr.count("\n") == 1
     assert bad.stderr.startswith("error: bad.toml: ")
+
+
+def test_cache_info_and_clear(scene, tmp_path, capsys):
+    cache = tmp_path / "cache"
+    assert main(["run", str(scene), "--out", str(tmp_path / "a"), "--cache-dir", str(cache),
+                 "-q"]) == 0
+    (cache / "notes.txt").write_text("not femmech's")
+    capsys.readouterr()
+    assert main(["cache", "info", "--cache-dir", str(cache)]) == 0
+    info = capsys.readouterr().out
+    assert f"reduction cache {cache}" in info
+    assert "1 entries" in info and "1 other files" in info
+    assert main(["cache", "clear", "--cache-dir", str(cache)]) == 0
+    assert "removed" in capsys.readouterr().out
+    assert [p.name for p in cache.iterdir()] == ["notes.txt"]
