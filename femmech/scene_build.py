@@ -355,20 +355,26 @@ def reduce_part(scene: Scene, part: PartSpec, model: fm.FEModel, f_max_hz: float
 
 
 def reduction_key_data(scene: Scene, part: PartSpec, f_max_hz: float | None = None) -> dict:
-    """Everything a part's reduction depends on, as plain JSON data: the mesh file's
-    content (SHA-256) or the generator parameters, the materials the part uses, its
-    properties, items, interface and reduction settings, the femmech version and the
-    superelement file format. The part's name and file paths are not part of it."""
-    mesh = plain(part.mesh)
+    """Everything a part's reduction depends on, as plain JSON data.
+
+    That is every field of the part's spec (so a field added to :class:`PartSpec` joins
+    the key by itself): the mesh file's content (SHA-256) or the generator's parameters,
+    ``edge_node_groups`` and ``merge_nodes``; sections, shells, solids, items; the
+    interface and every reduction setting (method, mode selection, residual vectors). Also
+    the materials the part uses, the femmech version, the superelement file format and
+    :data:`femmech.reduction.CUTOFF_FACTOR` (the modes an ``f_max_hz`` keeps). Not in it:
+    the part's name, file paths and scene locations, and the sparse solver backend and
+    thread counts, which change a reduction by round-off only.
+    """
+    data = plain(part)
+    del data["name"]
     if part.mesh.file is not None:
-        mesh["file"] = hashlib.sha256(Path(part.mesh.file).read_bytes()).hexdigest()
-    reduction = plain(part.reduction)
+        data["mesh"]["file"] = hashlib.sha256(Path(part.mesh.file).read_bytes()).hexdigest()
     if f_max_hz is not None:
-        reduction.update(n_modes=None, cutoff_hz=None, f_max_hz=float(f_max_hz))
-    return {"femmech": fm.__version__, "format": FORMAT_VERSION, "mesh": mesh,
-            "materials": {n: plain(scene.materials[n]) for n in part.materials_used()},
-            "sections": plain(part.sections), "shells": plain(part.shells),
-            "solids": plain(part.solids), "items": plain(part.items), "reduction": reduction}
+        data["reduction"].update(n_modes=None, cutoff_hz=None, f_max_hz=float(f_max_hz))
+    return {"femmech": fm.__version__, "format": FORMAT_VERSION,
+            "cutoff_factor": fm.reduction.CUTOFF_FACTOR, "part": data,
+            "materials": {n: plain(scene.materials[n]) for n in part.materials_used()}}
 
 
 def plain(obj):
@@ -379,10 +385,12 @@ def plain(obj):
                 if f.compare}
     if isinstance(obj, dict):
         return {str(k): plain(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
+    if isinstance(obj, (list, tuple, np.ndarray)):
         return [plain(v) for v in obj]
-    if isinstance(obj, (np.floating, np.integer)):
+    if isinstance(obj, (np.floating, np.integer, np.bool_)):
         return obj.item()
+    if isinstance(obj, Path):
+        return str(obj)
     return obj
 
 
