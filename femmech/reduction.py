@@ -18,12 +18,7 @@ never a dense matrix of full-model size.
 
 from __future__ import annotations
 
-import json
-import os
-import tempfile
 import time
-import zipfile
-import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -31,7 +26,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from femmech import threads
+from femmech import superelement_file, threads
 from femmech.dofs import DOF_PER_NODE, components, dof_label
 from femmech.linalg import factorize, solve_symmetric
 from femmech.model import FEModel, node_indices
@@ -43,7 +38,8 @@ shipped machine frame are accurate to 1.4e-6; plain Craig-Bampton
 (``residual_vectors=False``) reaches only 1.4e-2 there and needs about 6 f_max for 0.1 %
 (tests/test_reduction.py, benchmarks/reduction.py)."""
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = superelement_file.FORMAT_VERSION
+"""Format of superelement files (:mod:`femmech.superelement_file`)."""
 
 PIVOT_RTOL = 1e-11
 """A pivot of the ``K_ii`` factorisation below this fraction of its diagonal entry marks
@@ -160,52 +156,25 @@ class Superelement:
         return (self.T @ u.reshape(u.shape[0], -1)).reshape((self.n_dof,) + u.shape[1:])
 
     def save(self, path) -> Path:
-        """Write to one ``.npz`` file (atomically); read back with :meth:`load`."""
-        path = Path(path)
-        T = self.T.tocsr()
-        arrays = {name: getattr(self, name) for name in _ARRAYS}
-        meta = {"format_version": FORMAT_VERSION, "method": self.method,
-                "timings": self.timings, "n_dof": self.n_dof, "n_residual": self.n_residual}
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".npz")
-        try:
-            with os.fdopen(fd, "wb") as stream:
-                np.savez_compressed(stream, T_data=T.data, T_indices=T.indices,
-                                    T_indptr=T.indptr, T_shape=np.array(T.shape),
-                                    meta=np.array(json.dumps(meta)), **arrays)
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
-        return path
+        """Write to one ``.npz`` file (atomically); read back with :meth:`load`.
+
+        The format and its checks are described in :mod:`femmech.superelement_file`.
+        """
+        return superelement_file.write(self, path)
 
     @classmethod
     def load(cls, path) -> Superelement:
-        """Read a superelement written by :meth:`save`.
+        """Read a superelement written by :meth:`save`, validating every field first.
 
-        Raises ValueError naming the file if it is truncated, corrupt, not a superelement
-        file or of another format version.
+        Raises
+        ------
+        FileNotFoundError
+            If there is no file ``path``.
+        FileFormatError
+            (a ValueError) with one line naming the file and the field, if the file is
+            truncated, damaged, foreign, inconsistent or of an unknown format version.
         """
-        try:
-            with np.load(Path(path), allow_pickle=False) as data:
-                meta = json.loads(str(data["meta"]))
-                if meta.get("format_version") == FORMAT_VERSION:
-                    T = sp.csr_matrix((data["T_data"], data["T_indices"], data["T_indptr"]),
-                                      shape=tuple(data["T_shape"]))
-                    arrays = {name: data[name] for name in _ARRAYS}
-        except FileNotFoundError:
-            raise
-        except (OSError, EOFError, KeyError, ValueError, zipfile.BadZipFile, zlib.error) as exc:
-            raise ValueError(f"{path}: not a readable superelement file (truncated or"
-                             f" corrupt? {type(exc).__name__}: {exc})") from exc
-        if meta.get("format_version") != FORMAT_VERSION:
-            raise ValueError(f"{path}: superelement format {meta.get('format_version')},"
-                             f" expected {FORMAT_VERSION}")
-        return cls(method=meta["method"], T=T, timings=meta["timings"],
-                   n_residual=meta.get("n_residual", 0), **arrays)
-
-
-_ARRAYS = ("K", "M", "interface_dofs", "interface_points", "modal_omega2", "Psi", "Phi",
-           "free_interface", "free_interior")
+        return cls(**superelement_file.read(path))
 
 
 def interface_dofs(model: FEModel, interface) -> np.ndarray:
