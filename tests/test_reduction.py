@@ -27,6 +27,7 @@ from numpy.testing import assert_allclose, assert_array_equal, assert_array_less
 
 import femmech as fm
 from femmech import reduction, sections
+from femmech.errors import FileFormatError
 from femmech.generators import grid_frame
 from femmech.reduction import Superelement, craig_bampton, frequency_error_estimates, guyan
 
@@ -404,7 +405,7 @@ def test_load_rejects_damaged_files(tmp_path, grid):
     other = tmp_path / "other.npz"
     np.savez(other, K=np.eye(2))
     for bad in (truncated, corrupt, empty, other):
-        with pytest.raises(ValueError, match="not a readable superelement file"):
+        with pytest.raises(FileFormatError, match="not a readable superelement file"):
             Superelement.load(bad)
     with pytest.raises(FileNotFoundError):
         Superelement.load(tmp_path / "missing.npz")
