@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from femmech.mesh import Mesh
+from femmech.mesh import MAX_CELLS, MAX_NODES, Mesh
 
 
 def grid_frame(bays=(2, 2, 2), size=(1.0, 1.0, 1.0), subdivisions: int = 1) -> Mesh:
@@ -35,6 +35,13 @@ def grid_frame(bays=(2, 2, 2), size=(1.0, 1.0, 1.0), subdivisions: int = 1) -> M
         raise ValueError(f"size must be three positive lengths, got {size}")
     if subdivisions < 1:
         raise ValueError(f"subdivisions must be >= 1, got {subdivisions}")
+    bx, by, bz = bays
+    n_members = bx * (by + 1) * (bz + 1) + by * (bx + 1) * (bz + 1) + bz * (bx + 1) * (by + 1)
+    n_nodes = (bx + 1) * (by + 1) * (bz + 1) + (subdivisions - 1) * n_members
+    if n_nodes > MAX_NODES or n_members * subdivisions > MAX_CELLS:
+        raise ValueError(f"grid_frame{bays} with {subdivisions} subdivisions would have"
+                         f" {n_members * subdivisions} elements and {n_nodes} nodes; at most"
+                         f" {MAX_CELLS} and {MAX_NODES} (MAX_CELLS, MAX_NODES)")
     shape = tuple(b + 1 for b in bays)
     axes = [np.linspace(0.0, s, n) for s, n in zip(size, shape, strict=True)]
     X, Y, Z = np.meshgrid(*axes, indexing="ij")
@@ -110,33 +117,52 @@ def members_frame(joints, members, node_sets=None) -> Mesh:
     names = list(joints)
     index = {name: i for i, name in enumerate(names)}
     points = [np.array([joints[n] for n in names], dtype=float).reshape(-1, 3)]
-    n_points, lines, groups = len(names), [], {}
-    for m, member in enumerate(members):
-        chain = list(member["chain"])
-        unknown = [j for j in chain if j not in index]
-        if len(chain) < 2 or unknown:
-            raise ValueError(f"member {m} ({member['group']!r}): chain {chain} needs >= 2 known"
-                             f" joints; unknown: {unknown}")
-        for a, b in zip(chain[:-1], chain[1:], strict=True):
-            pa, pb = points[0][index[a]], points[0][index[b]]
-            length = float(np.linalg.norm(pb - pa))
-            if not (np.isfinite(length) and length > 0.0):
-                raise ValueError(f"member {m} ({member['group']!r}): joints {a!r} and {b!r}"
-                                 f" are {length} m apart")
-            k = member.get("divisions") or max(1, round(length / member["element_size"]))
-            if k > MAX_ELEMENTS_PER_MEMBER:
-                raise ValueError(f"member {m} ({member['group']!r}) from {a!r} to {b!r}: {k}"
-                                 f" elements (length {length:.6g} m); at most"
-                                 f" {MAX_ELEMENTS_PER_MEMBER} per member")
-            inner = pa + np.outer(np.arange(1, k) / k, pb - pa)
-            ids = np.concatenate([[index[a]], n_points + np.arange(k - 1), [index[b]]])
-            points.append(inner)
-            n_points += k - 1
-            first = sum(len(c) for c in lines)
-            lines.append(np.column_stack([ids[:-1], ids[1:]]))
-            groups.setdefault(member["group"], []).append(first + np.arange(k))
+    pieces = [(m, member, a, b, _divisions(m, member, a, b, points[0], index))
+              for m, member in enumerate(members) for a, b in _pairs(m, member, index)]
+    n_elements = sum(k for *_, k in pieces)
+    n_nodes = len(names) + n_elements - len(pieces)
+    if n_nodes > MAX_NODES or n_elements > MAX_CELLS:
+        raise ValueError(f"the members would have {n_elements} elements and {n_nodes} nodes;"
+                         f" at most {MAX_CELLS} and {MAX_NODES} (MAX_CELLS, MAX_NODES)")
+    n_points, n_lines, lines, groups = len(names), 0, [], {}
+    for _, member, a, b, k in pieces:
+        pa, pb = points[0][index[a]], points[0][index[b]]
+        inner = pa + np.outer(np.arange(1, k) / k, pb - pa)
+        ids = np.concatenate([[index[a]], n_points + np.arange(k - 1), [index[b]]])
+        points.append(inner)
+        n_points += k - 1
+        lines.append(np.column_stack([ids[:-1], ids[1:]]))
+        groups.setdefault(member["group"], []).append(n_lines + np.arange(k))
+        n_lines += k
     sets = {n: [i] for n, i in index.items()}
     for name, members_of_set in (node_sets or {}).items():
+        unknown = [j for j in members_of_set if j not in index]
+        if unknown:
+            raise ValueError(f"node set {name!r}: unknown joints {unknown[:10]}")
         sets[name] = [index[j] for j in members_of_set]
     cell_sets = {g: np.concatenate(parts) for g, parts in groups.items()}
     return Mesh.from_lines(np.vstack(points), np.vstack(lines), cell_sets, sets)
+
+
+def _pairs(m: int, member, index: dict):
+    """Consecutive joint pairs of a member's chain (names checked)."""
+    chain = list(member["chain"])
+    unknown = [j for j in chain if j not in index]
+    if len(chain) < 2 or unknown:
+        raise ValueError(f"member {m} ({member['group']!r}): chain {chain[:10]} needs >= 2"
+                         f" known joints; unknown: {unknown[:10]}")
+    return zip(chain[:-1], chain[1:], strict=True)
+
+
+def _divisions(m: int, member, a: str, b: str, points, index: dict) -> int:
+    """Elements of the straight member from joint ``a`` to ``b`` (see members_frame)."""
+    length = float(np.linalg.norm(points[index[b]] - points[index[a]]))
+    if not (np.isfinite(length) and length > 0.0):
+        raise ValueError(f"member {m} ({member['group']!r}): joints {a!r} and {b!r}"
+                         f" are {length} m apart")
+    k = member.get("divisions") or length / member["element_size"]
+    if not (np.isfinite(k) and round(k) <= MAX_ELEMENTS_PER_MEMBER):
+        raise ValueError(f"member {m} ({member['group']!r}) from {a!r} to {b!r}: {k:.6g}"
+                         f" elements (length {length:.6g} m); at most"
+                         f" {MAX_ELEMENTS_PER_MEMBER} per member")
+    return max(1, round(k))

@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 from pathlib import Path
 
 import numpy as np
 
-from femmech.mesh import NODES_PER_CELL, Mesh
+from femmech.mesh import MAX_CELLS, MAX_NODES, NODES_PER_CELL, Mesh
+
+MAX_MESH_FILE_BYTES = 4 * 2**30
+"""Largest mesh file read, bytes (an ASCII Gmsh file of a million nodes and five million
+tetrahedra has about 400 MB); a mesh file is untrusted input, refused before reading."""
 
 
 def from_meshio(mesh) -> Mesh:
@@ -35,10 +41,16 @@ def from_meshio(mesh) -> Mesh:
         for block, offset, idx in zip(mesh.cells, offsets, per_block, strict=True):
             if idx is None or len(idx) == 0:
                 continue
-            by_type.setdefault(block.type, []).append(np.asarray(idx, dtype=np.int64) + offset)
+            idx = np.asarray(idx)
+            if idx.dtype.kind not in "iu" or idx.min() < 0 or idx.max() >= len(block.data):
+                raise ValueError(f"group {name!r} references {block.type} cells outside the"
+                                 f" {len(block.data)} of its block")
+            by_type.setdefault(block.type, []).append(idx.astype(np.int64) + offset)
         by_type = {kind: np.concatenate(parts) for kind, parts in by_type.items()}
         if set(by_type) == {"vertex"}:
             node_sets[name] = np.unique(merged["vertex"][by_type["vertex"]])
+            if node_sets[name].dtype.kind not in "iu":
+                raise ValueError(f"node group {name!r}: vertex cells must hold node indices")
         else:
             by_type.pop("vertex", None)
             cell_sets[name] = by_type
@@ -87,14 +99,26 @@ def read_mesh(path) -> Mesh:
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"mesh file not found: {path}")
+    size = path.stat().st_size
+    if size > MAX_MESH_FILE_BYTES:
+        raise ValueError(f"{path}: file of {size} bytes; at most {MAX_MESH_FILE_BYTES}"
+                         " (limit MAX_MESH_FILE_BYTES)")
+    said = io.StringIO()  # meshio prints warnings and errors of its own; keep them
     try:
-        raw = meshio.read(path)
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            raw = meshio.read(path)
     except Exception as exc:  # meshio raises many types; report them uniformly
         raise ValueError(f"{path}: meshio could not read the file ({exc})") from exc
     except SystemExit as exc:  # meshio 5.3 calls sys.exit(1) when no reader succeeds
+        first = " ".join(said.getvalue().split())[:200]
         raise ValueError(f"{path}: meshio could not read the file (no reader for its"
-                         " extension accepted the contents)") from exc
+                         f" extension accepted the contents: {first})") from exc
+    n_points = len(raw.points)
+    n_cells = sum(len(block.data) for block in raw.cells)
+    if n_points > MAX_NODES or n_cells > MAX_CELLS:
+        raise ValueError(f"{path}: {n_points} nodes and {n_cells} cells; at most {MAX_NODES}"
+                         f" and {MAX_CELLS} (limits MAX_NODES, MAX_CELLS)")
     try:
         return from_meshio(raw)
-    except ValueError as exc:
+    except (ValueError, TypeError) as exc:
         raise ValueError(f"{path}: {exc}") from exc

@@ -16,6 +16,14 @@ NODES_PER_CELL = {
     "hexahedron27": 27, "wedge": 6,
 }
 
+MAX_NODES = 10_000_000
+"""Most nodes of a mesh read from a file or generated for a scene (60 million beam DOFs;
+a real machine model has a few million). Scenes and mesh files are untrusted input: a
+larger count is refused before it is allocated (:func:`femmech.io.read_mesh`,
+:mod:`femmech.generators`)."""
+MAX_CELLS = 20_000_000
+"""Most cells (elements) of a mesh read from a file or generated for a scene."""
+
 
 @dataclass(frozen=True)
 class Mesh:

@@ -20,8 +20,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from femmech.errors import SceneError
-from femmech.scene_analyses import Analyses, read_analyses
-from femmech.scene_reader import Reader
+from femmech.scene_analyses import MAX_MODES, Analyses, read_analyses
+from femmech.scene_mesh import MeshSpec, read_mesh_spec
+from femmech.scene_reader import MAX_SCENE_BYTES, Reader, check_limits, one_line, show
 from femmech.units import (
     AREA,
     DENSITY,
@@ -46,11 +47,14 @@ SECTION_SHAPES = {
 }
 """Section shapes of :mod:`femmech.sections` and their required dimensions."""
 GENERAL_OPTIONAL = (("Asy", AREA), ("Asz", AREA), ("Ip", SECOND_MOMENT))
-GENERATORS = ("grid_frame", "members")
 REDUCTIONS = ("guyan", "craig_bampton")
 _SPRING_KINDS = (STIFFNESS,) * 3 + (ROT_STIFFNESS,) * 3
-
-
+_SECTION_KEYS = ("section", "material", "orientation", "shear", "rotary_inertia")
+_DIMENSION_KEYS = tuple(dict.fromkeys(
+    key for dims in (*SECTION_SHAPES.values(), GENERAL_OPTIONAL) for key, _ in dims))
+_PART_KEYS = ("mesh", "generator", "edge_node_groups", "merge_nodes", "sections", "shells",
+              "solids", "supports", "masses", "springs", "rigid_links", "interpolating_links",
+              "reduction")
 @dataclass(frozen=True)
 class MaterialSpec:
     """Isotropic material: E (Pa), rho (kg/m³), nu or G (Pa)."""
@@ -93,19 +97,6 @@ class SolidSpec:
     group: str
     material: str
     where: str = field(default="", compare=False)
-
-
-@dataclass(frozen=True)
-class MeshSpec:
-    """A mesh file (absolute path) or a generator with its parameters (SI); nodes closer
-    than ``merge_tol`` (m) are merged (:meth:`femmech.Mesh.merge_nodes`)."""
-
-    file: str | None = None
-    generator: str | None = None
-    params: dict = field(default_factory=dict)
-    edge_node_groups: tuple = ()
-    where: str = field(default="", compare=False)
-    merge_tol: float | None = None
 
 
 @dataclass(frozen=True)
@@ -192,19 +183,19 @@ class Scene:
         resolved against ``base_dir``."""
         from femmech.scene_machine import read_mechanisms, read_mounts
 
+        check_limits(data, file)
         root = Reader(data, "", file)
+        root.expect("scene", "materials", "parts", "mechanisms", "mounts", "analyses")
         base = Path(base_dir).resolve()
-        head = root.child("scene", root.get("scene", {}))
+        head = root.table("scene", {})
+        head.expect("name", "description")
         name = head.string("name", "scene")
         description = head.string("description", "")
-        head.finish()
         materials = {n: _material(n, r) for n, r in root.named_tables("materials").items()}
         parts = {n: _part(n, r, base, materials) for n, r in root.named_tables("parts").items()}
         mechanisms = read_mechanisms(root, base)
         mounts = read_mounts(root, parts, mechanisms)
-        analyses = read_analyses(root.child("analyses", root.get("analyses", {})), parts,
-                                 mechanisms, bool(mounts))
-        root.finish()
+        analyses = read_analyses(root.table("analyses", {}), parts, mechanisms, bool(mounts))
         if not parts and not mechanisms:
             raise root.error(None, "the scene has neither [parts] nor [mechanisms]")
         return cls(name, description, file, base, materials, parts, mechanisms, mounts,
@@ -212,23 +203,32 @@ class Scene:
 
 
 def load_scene(path) -> Scene:
-    """Read and validate a scene file (TOML); raises SceneError (one line) when invalid."""
+    """Read and validate a scene file (TOML, UTF-8 with or without a byte-order mark);
+    raises SceneError (one line) when invalid."""
     path = Path(path)
     if not path.is_file():
-        raise SceneError(f"{path}: scene file not found")
+        raise SceneError(one_line(f"{path}: scene file not found"))
+    name = one_line(path.name)
+    size = path.stat().st_size
+    if size > MAX_SCENE_BYTES:
+        raise SceneError(f"{name}: file of {size} bytes; a scene has at most"
+                         f" {MAX_SCENE_BYTES} (limit MAX_SCENE_BYTES)")
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise SceneError(f"{path.name}: not valid TOML ({exc})") from None
-    return Scene.from_dict(data, path.parent, path.name)
+        raise SceneError(one_line(f"{name}: not valid TOML ({exc})")) from None
+    except RecursionError:  # tomllib recurses into nested arrays and inline tables
+        raise SceneError(f"{name}: not valid TOML (arrays or tables nested too deeply)"
+                         ) from None
+    return Scene.from_dict(data, path.parent, name)
 
 
 def _material(name: str, r: Reader) -> MaterialSpec:
+    r.expect("E", "rho", "nu", "G")
     E = r.number("E", PRESSURE, positive=True)
     rho = r.number("rho", DENSITY, non_negative=True)
     nu = r.number("nu", DIMENSIONLESS, None)
     G = r.number("G", PRESSURE, None, positive=True)
-    r.finish()
     if (nu is None) == (G is None):
         raise r.error(None, "give exactly one of nu and G")
     if nu is not None and not -1.0 < nu < 0.5:
@@ -245,82 +245,43 @@ def _material_name(r: Reader, materials: dict) -> str:
 
 
 def _section(group: str, r: Reader, materials: dict) -> SectionSpec:
+    r.expect(*_SECTION_KEYS, *_DIMENSION_KEYS)
     shape = r.string("section", choices=SECTION_SHAPES)
-    dims = [(key, r.number(key, kind, positive=True)) for key, kind in SECTION_SHAPES[shape]]
-    if shape == "general":
-        dims += [(key, r.number(key, kind, positive=True)) for key, kind in GENERAL_OPTIONAL
-                 if r.has(key)]
+    kinds = SECTION_SHAPES[shape] + (GENERAL_OPTIONAL if shape == "general" else ())
+    r.expect(*_SECTION_KEYS, *(key for key, _ in kinds), context=f"for section = {shape!r}")
+    dims = [(key, r.number(key, kind, positive=True)) for key, kind in kinds
+            if r.has(key) or (key, kind) not in GENERAL_OPTIONAL]
+    _check_dimensions(r, shape, dict(dims))
     material = _material_name(r, materials)
     orientation = r.vector("orientation", (DIMENSIONLESS,) * 3, None)
-    spec = SectionSpec(group, shape, tuple(dims), material, orientation,
+    if orientation is not None and not any(orientation):
+        raise r.error("orientation", "expected a non-zero vector (the local y axis)")
+    return SectionSpec(group, shape, tuple(dims), material, orientation,
                        r.boolean("shear", True), r.boolean("rotary_inertia", True), r.where)
-    r.finish()
-    return spec
 
 
-def _mesh(r: Reader, base: Path) -> MeshSpec:
-    if r.has("mesh") == r.has("generator"):
-        raise r.error(None, "give exactly one of mesh (a file) and generator (a table)")
-    edges = r.strings("edge_node_groups", ())
-    merge = r.number("merge_nodes", LENGTH, None, positive=True)
-    if r.has("mesh"):
-        file = base / r.string("mesh")
-        if not file.is_file():
-            raise r.error("mesh", f"file not found: {file}")
-        return MeshSpec(str(file), None, {}, edges, r.where, merge)
-    g = r.child("generator", r.get("generator"))
-    kind = g.string("kind", choices=GENERATORS)
-    if kind == "grid_frame":
-        bays = g.get("bays")
-        if not (isinstance(bays, list) and len(bays) == 3 and all(
-                isinstance(b, int) and not isinstance(b, bool) and 0 <= b <= 1000
-                for b in bays)):
-            raise g.error("bays", f"expected three integers in 0..1000, got {bays!r}")
-        params = {"bays": tuple(bays), "size": g.vector("size", (LENGTH,) * 3),
-                  "subdivisions": g.integer("subdivisions", 1, minimum=1)}
-        if params["subdivisions"] > 10_000:
-            raise g.error("subdivisions", f"expected at most 10000, got {params['subdivisions']}")
-    else:
-        params = _members(g)
-    g.finish()
-    return MeshSpec(None, kind, params, edges, g.where, merge)
+def _check_dimensions(r: Reader, shape: str, dims: dict) -> None:
+    """Dimensions that fit together (the checks of :mod:`femmech.sections`, at the key)."""
+    from femmech import sections
 
-
-def _members(g: Reader) -> dict:
-    raw = g.get("joints")
-    if not isinstance(raw, dict):
-        raise g.error("joints", f"expected a table {{name = [x, y, z]}}, got {raw!r}")
-    joints = {}
-    for name, xyz in raw.items():
-        if not isinstance(xyz, list) or len(xyz) != 3:
-            raise g.error(f"joints.{name}", f"expected three coordinates, got {xyz!r}")
-        joints[name] = tuple(g.convert(f"joints.{name}", v, LENGTH) for v in xyz)
-    if not joints:
-        raise g.error("joints", "missing (required): a table {name = [x, y, z]}")
-    members = []
-    for m in g.tables("members"):
-        chain = m.strings("chain")
-        bad = [j for j in chain if j not in joints]
-        if len(chain) < 2 or bad:
-            raise m.error("chain", f"expected >= 2 joint names of [joints], got {list(chain)}")
-        size = m.number("element_size", LENGTH, None, positive=True)
-        divisions = m.integer("divisions", None, minimum=1)
-        if (size is None) == (divisions is None):
-            raise m.error(None, "give exactly one of element_size and divisions")
-        members.append({"group": m.string("group"), "chain": chain, "element_size": size,
-                        "divisions": divisions})
-        m.finish()
-    if not members:
-        raise g.error("members", "missing (required): [[...members]] with group and chain")
-    node_sets, raw_sets = {}, g.get("node_sets", {})
-    if not isinstance(raw_sets, dict):
-        raise g.error("node_sets", f"expected a table {{name = [joints]}}, got {raw_sets!r}")
-    for name, value in raw_sets.items():
-        if not isinstance(value, list) or not all(isinstance(v, str) and v in joints
-                                                  for v in value):
-            raise g.error(f"node_sets.{name}", f"expected a list of joint names, got {value!r}")
-        node_sets[name] = tuple(value)
-    return {"joints": joints, "members": tuple(members), "node_sets": node_sets}
+    if shape == "tube" and not dims["inner_diameter"] < dims["outer_diameter"]:
+        raise r.error("inner_diameter", f"expected less than outer_diameter"
+                      f" ({dims['outer_diameter']:g} m), got {dims['inner_diameter']:g} m")
+    if shape == "i_section":
+        if not 2 * dims["flange"] < dims["height"]:
+            raise r.error("flange", f"expected less than half the height"
+                          f" ({dims['height']:g} m), got {dims['flange']:g} m")
+        if not dims["web"] < dims["width"]:
+            raise r.error("web", f"expected less than the width ({dims['width']:g} m), got"
+                          f" {dims['web']:g} m")
+    if shape == "rectangular_hollow" and not 2 * dims["wall"] < min(dims["width"],
+                                                                   dims["height"]):
+        raise r.error("wall", f"expected less than half the smaller of width and height"
+                      f" ({min(dims['width'], dims['height']):g} m), got {dims['wall']:g} m")
+    try:  # anything else the section factory refuses (e.g. an overflowing property)
+        getattr(sections, shape)(**dims)
+    except (ValueError, TypeError, OverflowError) as exc:
+        raise r.error(None, str(exc)) from None
 
 
 def _dofs(r: Reader, key: str, default="all"):
@@ -329,9 +290,10 @@ def _dofs(r: Reader, key: str, default="all"):
     value = r.get(key, default)
     try:
         if not isinstance(value, (str, list)):
-            raise ValueError(f"expected a component name or a list of them, got {value!r}")
-        components(value)
-    except ValueError as exc:
+            raise ValueError(f"expected a component name or a list of them, got {show(value)}")
+        if not components(value).size:
+            raise ValueError("expected at least one component")
+    except (ValueError, TypeError) as exc:
         raise r.error(key, str(exc)) from None
     return value if isinstance(value, str) else tuple(value)
 
@@ -339,62 +301,88 @@ def _dofs(r: Reader, key: str, default="all"):
 def _items(r: Reader) -> list[ItemSpec]:
     items = []
     for s in r.tables("supports"):
+        s.expect("nodes", "dofs")
         items.append(ItemSpec("support", {"nodes": s.node_ref("nodes", many=True),
                                           "dofs": _dofs(s, "dofs")}, s.where))
-        s.finish()
     for m in r.tables("masses"):
+        m.expect("node", "mass", "inertia")
+        inertia = m.vector("inertia", (INERTIA,) * 3, None)
+        if inertia is not None and min(inertia) < 0:
+            raise m.error("inertia", f"expected three values >= 0, got {inertia}")
         items.append(ItemSpec("mass", {"node": m.node_ref("node"),
                                        "mass": m.number("mass", MASS, non_negative=True),
-                                       "inertia": m.vector("inertia", (INERTIA,) * 3, None)},
-                              m.where))
-        m.finish()
+                                       "inertia": inertia}, m.where))
     for s in r.tables("springs"):
-        value = s.get("stiffness")
-        stiffness = s.vector("stiffness", _SPRING_KINDS) if isinstance(value, list) else \
-            s.number("stiffness", STIFFNESS, non_negative=True)
-        node_b = s.node_ref("node_b", default=None)
-        nodes = s.get("node_a")
-        if isinstance(nodes, list) and node_b is None:  # one grounded spring per node
-            for node in nodes:
-                s.child("node_a", {"node": node}).node_ref("node")
-        else:
-            nodes = [s.node_ref("node_a")]
-        items += [ItemSpec("spring", {"node_a": node, "node_b": node_b,
-                                      "stiffness": stiffness}, s.where) for node in nodes]
-        s.finish()
+        items += _springs(s)
+    tied = {}  # slave reference → the link that ties it
     for k in r.tables("rigid_links"):
-        items.append(ItemSpec("rigid_link", {"master": k.node_ref("master"),
-                                             "slaves": k.node_ref("slaves", many=True)},
-                              k.where))
-        k.finish()
+        k.expect("master", "slaves")
+        master, slaves = k.node_ref("master"), k.node_ref("slaves", many=True)
+        for ref in slaves if isinstance(slaves, tuple) else (slaves,):
+            if ref in tied or ref == master:
+                other = "its master" if ref == master else tied[ref]
+                raise k.error("slaves", f"node {ref!r} is already tied by {other}; a node"
+                                        " follows at most one rigid link")
+            tied[ref] = k.where.rsplit(".", 1)[-1]
+        items.append(ItemSpec("rigid_link", {"master": master, "slaves": slaves}, k.where))
     for k in r.tables("interpolating_links"):
-        weights = k.get("weights", None)
-        if weights is not None:
-            if not isinstance(weights, list):
-                raise k.error("weights", f"expected a list of numbers, got {weights!r}")
-            weights = tuple(k.convert("weights", w, DIMENSIONLESS, non_negative=True)
-                            for w in weights)
-        items.append(ItemSpec("interpolating_link",
-                              {"reference": k.node_ref("reference"),
-                               "patch": k.node_ref("patch", many=True), "weights": weights},
-                              k.where))
-        k.finish()
+        items.append(_interpolating_link(k))
     return items
+
+
+def _springs(s: Reader) -> list[ItemSpec]:
+    s.expect("node_a", "node_b", "stiffness")
+    value = s.get("stiffness")
+    stiffness = s.vector("stiffness", _SPRING_KINDS) if isinstance(value, list) else \
+        s.number("stiffness", STIFFNESS, non_negative=True)
+    if isinstance(value, list) and min(stiffness) < 0:
+        raise s.error("stiffness", f"expected six values >= 0, got {show(value)}")
+    node_b = s.node_ref("node_b", default=None)
+    nodes = s.get("node_a")
+    if isinstance(nodes, list) and node_b is None:  # one grounded spring per node
+        for i, node in enumerate(nodes):
+            s.child(f"node_a[{i}]", {"node": node}).node_ref("node")
+    else:
+        nodes = [s.node_ref("node_a")]
+        if nodes[0] == node_b:
+            raise s.error("node_b", f"a spring joins two nodes; node_a and node_b are both"
+                                    f" {node_b!r}")
+    return [ItemSpec("spring", {"node_a": node, "node_b": node_b, "stiffness": stiffness},
+                     s.where) for node in nodes]
+
+
+def _interpolating_link(k: Reader) -> ItemSpec:
+    k.expect("reference", "patch", "weights")
+    patch = k.node_ref("patch", many=True)
+    weights = k.get("weights", None)
+    if weights is not None:
+        if not isinstance(weights, list) or not weights:
+            raise k.error("weights", f"expected a list of numbers, got {show(weights)}")
+        weights = tuple(k.convert("weights", w, DIMENSIONLESS, non_negative=True)
+                        for w in weights)
+        if not any(weights):
+            raise k.error("weights", "expected at least one positive weight")
+        if isinstance(patch, tuple) and len(patch) != len(weights):
+            raise k.error("weights", f"expected one weight per patch node ({len(patch)}),"
+                                     f" got {len(weights)}")
+    return ItemSpec("interpolating_link", {"reference": k.node_ref("reference"),
+                                           "patch": patch, "weights": weights}, k.where)
 
 
 def _reduction(r: Reader) -> ReductionSpec:
     from femmech.units import FREQUENCY
 
+    r.expect("method", "interface", "n_modes", "cutoff_hz", "f_max_hz", "residual_vectors")
     method = r.string("method", choices=REDUCTIONS)
     interface = []
     for i in r.tables("interface"):
+        i.expect("nodes", "dofs")
         interface.append(InterfaceSpec(i.node_ref("nodes", many=True), _dofs(i, "dofs"),
                                        i.where))
-        i.finish()
     if not interface:
         raise r.error("interface", "missing (required): [[...reduction.interface]] entries"
                                    " with nodes and dofs")
-    n_modes = r.integer("n_modes", None, minimum=0)
+    n_modes = r.integer("n_modes", None, minimum=0, maximum=MAX_MODES, limit="MAX_MODES")
     cutoff = r.number("cutoff_hz", FREQUENCY, None, positive=True)
     f_max = r.number("f_max_hz", FREQUENCY, None, positive=True)
     given = sum(v is not None for v in (n_modes, cutoff, f_max))
@@ -407,27 +395,25 @@ def _reduction(r: Reader) -> ReductionSpec:
                          r.boolean("residual_vectors", method == "craig_bampton"), r.where)
     if method == "guyan" and spec.residual_vectors:
         raise r.error("residual_vectors", "residual vectors need method = 'craig_bampton'")
-    r.finish()
     return spec
 
 
 def _part(name: str, r: Reader, base: Path, materials: dict) -> PartSpec:
-    mesh = _mesh(r, base)
+    r.expect(*_PART_KEYS)
+    mesh = read_mesh_spec(r, base)
     sections = tuple(_section(g, t, materials) for g, t in r.named_tables("sections").items())
     shells, solids = [], []
     for group, t in r.named_tables("shells").items():
+        t.expect("thickness", "material")
         shells.append(ShellSpec(group, t.number("thickness", LENGTH, positive=True),
                                 _material_name(t, materials), t.where))
-        t.finish()
     for group, t in r.named_tables("solids").items():
+        t.expect("material")
         solids.append(SolidSpec(group, _material_name(t, materials), t.where))
-        t.finish()
     if not (sections or shells or solids):
         raise r.error("sections", "missing (required): give [sections.<group>] (beams),"
                                   " [shells.<group>] or [solids.<group>]")
     items = _items(r)
-    reduction = _reduction(r.child("reduction", r.get("reduction"))) if r.has("reduction") \
-        else None
-    r.finish()
+    reduction = _reduction(r.table("reduction")) if r.has("reduction") else None
     return PartSpec(name, mesh, sections, tuple(shells), tuple(solids), tuple(items), reduction,
                     r.where)

@@ -2,7 +2,7 @@
 
 A quantity is a plain number (taken as SI: m, kg, s, N, Pa, rad) or a string of a number
 and a unit expression: unit names from :data:`UNITS`, joined by ``*`` (or a space, or
-``·``) and ``/``, each with an optional integer power (``m^2``, ``m2``, ``s^-1``):
+``·``) and ``/``, each with an optional integer power from -9 to 9 (``m^2``, ``m2``, ``s^-1``):
 ``"7850 kg/m^3"``, ``"2e4 N*m/rad"``, ``"1200 rpm"``, ``"90 deg"``.
 
 Dimensions are exponents of (kg, m, s, rad). The radian is kept as its own dimension so
@@ -72,7 +72,10 @@ KINDS = (LENGTH, AREA, SECOND_MOMENT, MASS, TIME, FORCE, MOMENT, PRESSURE, DENSI
          STIFFNESS, ROT_STIFFNESS, DAMPING, ROT_DAMPING, FREQUENCY, ANGLE, SPEED, DIMENSIONLESS)
 
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
-_FACTOR = re.compile(r"^([A-Za-z]+)(?:\^?(-?\d+))?$")
+_FACTOR = re.compile(r"^([A-Za-z]+)(?:\^?(-?\d))?$")  # powers -9..9
+MAX_TEXT = 200
+"""Longest quantity string, characters (``"7850 kg/m^3"``): longer ones are refused before
+they are parsed."""
 
 
 def parse_unit(text: str) -> tuple[float, Dimension]:
@@ -125,8 +128,13 @@ def quantity(value, kind: Kind | None) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, str)):
         raise TypeError(_expected(kind))
     if not isinstance(value, str):
-        out = float(value)
+        try:
+            out = float(value)
+        except OverflowError:  # an integer beyond the float range
+            raise ValueError(f"{_expected(kind)}; the value is not finite") from None
     else:
+        if len(value) > MAX_TEXT:
+            raise ValueError(f"{_expected(kind)}; longer than {MAX_TEXT} characters")
         match = _NUMBER.match(value)
         if not match:
             raise ValueError(_expected(kind))
@@ -140,7 +148,7 @@ def quantity(value, kind: Kind | None) -> float:
                 raise ValueError(f"{_expected(kind)}; {exc}") from None
             if kind is not None and dim != kind.dimension:
                 raise ValueError(f"{_expected(kind)}; unit {unit!r} is {describe(dim)}")
-            out = number * factor
+            out = number * factor  # float product: overflows to inf, tested below
     if not math.isfinite(out):
         raise ValueError(f"{_expected(kind)}; the value is not finite")
     return out

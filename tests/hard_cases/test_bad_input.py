@@ -5,8 +5,9 @@ sections; lumped items; build_model arguments) must give a ValueError or TypeErr
 names the offending item, raised by femmech's own checks, never a traceback from deep
 inside numpy or scipy and never a silently wrong model.
 
-Scene files (issue 8) are left out here: their reader is being written in parallel
-(femmech/scene.py); their fuzzing belongs with it.
+Mesh files are untrusted input too (issue 19): a damaged or oversized file gives a
+ValueError naming the file. Scene files are fuzzed in tests/test_scene_fuzz.py (and at
+length by benchmarks/fuzz_scenes.py).
 """
 
 import traceback
@@ -342,3 +343,53 @@ def test_random_corruption_gives_a_clean_error_or_a_sound_model(data):
         return
     assert np.isfinite(result.freq_hz).all()
     assert np.all(result.freq_hz > 0)
+
+
+# --- mesh files: damaged or oversized files give a ValueError naming the file ------------
+
+MESH = Path(__file__).resolve().parents[2] / "meshes" / "machine_frame.msh"
+
+
+def test_mesh_file_size_and_counts_are_bounded(tmp_path, monkeypatch):
+    import femmech.io
+
+    monkeypatch.setattr(femmech.io, "MAX_MESH_FILE_BYTES", 1000)
+    with pytest.raises(ValueError, match=r"machine_frame.msh: file of \d+ bytes; at most 1000"
+                                         r" \(limit MAX_MESH_FILE_BYTES\)"):
+        fm.read_mesh(MESH)
+    monkeypatch.undo()
+    monkeypatch.setattr(femmech.io, "MAX_NODES", 100)
+    with pytest.raises(ValueError, match=r"machine_frame.msh: 188 nodes and \d+ cells; at most"
+                                         r" 100 and"):
+        fm.read_mesh(MESH)
+
+
+@settings(max_examples=40, deadline=None, database=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+def test_damaged_mesh_file_gives_a_clean_error_or_a_mesh(tmp_path, capsys, data):
+    """Bytes of a Gmsh file overwritten, dropped or digits changed: read_mesh returns a
+    Mesh (the damage hit a number or a comment) or raises a ValueError naming the file;
+    meshio's own messages do not leak to the terminal."""
+    raw = bytearray(MESH.read_bytes())
+    at = data.draw(st.integers(0, len(raw) - 1))
+    how = data.draw(st.sampled_from(["byte", "digit", "cut", "minus"]))
+    if how == "byte":
+        raw[at] = data.draw(st.integers(0, 255))
+    elif how == "digit":
+        raw[at:at + 1] = data.draw(st.sampled_from([b"9", b"99999999999", b"0", b""]))
+    elif how == "cut":
+        del raw[at:]
+    else:
+        raw[at:at] = b"-"
+    path = tmp_path / "damaged.msh"
+    path.write_bytes(bytes(raw))
+    try:
+        result = fm.read_mesh(path)
+    except ValueError as exc:
+        result = str(exc)
+    if isinstance(result, str):
+        assert result.startswith(f"{path}: "), result
+    else:
+        assert isinstance(result, fm.Mesh)
+    assert capsys.readouterr() == ("", "")
