@@ -52,6 +52,13 @@ distance between two corner nodes) at either node."""
 MAX_LISTED = 5
 """Node pairs, parts or items named in one message; the others are counted."""
 
+MAX_PAIRS = 1_000_000
+"""Above this many node pairs closer than the near-node distance (clusters of coincident
+nodes: k nodes make k(k-1)/2 pairs), :func:`near_nodes` pairs each node with its
+:data:`K_NEAREST` nearest neighbours only, so the check stays O(n log n)."""
+
+K_NEAREST = 8
+
 SI_E_ABOVE = 1e8
 """E >= 1e8 means Pa: no material is stiffer than 1e8 N/mm² (diamond: 1.2e6 N/mm²)."""
 
@@ -174,7 +181,16 @@ def near_nodes(points: np.ndarray, cells: dict, joined=(), tol: float | None = N
     empty = np.empty((0, 2), dtype=np.int64), np.empty(0)
     if tol <= 0 or len(points) < 2:
         return empty
-    pairs = cKDTree(points).query_pairs(tol, output_type="ndarray")
+    tree = cKDTree(points)
+    n_close = (int(tree.count_neighbors(tree, tol)) - len(points)) // 2  # dual-tree count
+    if n_close <= MAX_PAIRS:
+        pairs = tree.query_pairs(tol, output_type="ndarray")
+    else:  # a dense cluster (many coincident nodes) has ~k^2/2 pairs: each node's nearest
+        # K_NEAREST neighbours instead, which still names every near node
+        dist, idx = tree.query(points, k=K_NEAREST + 1, distance_upper_bound=tol)
+        rows = np.repeat(np.arange(len(points)), K_NEAREST + 1).reshape(idx.shape)
+        hit = np.isfinite(dist) & (idx != rows)
+        pairs = np.unique(np.sort(np.column_stack([rows[hit], idx[hit]]), axis=1), axis=0)
     if not len(pairs):
         return empty
     pairs = np.sort(pairs, axis=1)
@@ -222,10 +238,11 @@ def near_node_findings(points, cells, joined=(), tol: float | None = None) -> li
     pairs, dist = near_nodes(points, cells, joined, tol)
     if not len(pairs):
         return []
-    named = [f"nodes {a} and {b} are {d:.3g} m apart" for (a, b), d in zip(pairs, dist,
-                                                                         strict=True)]
+    named = [f"nodes {a} and {b} are {d:.3g} m apart"
+             for (a, b), d in zip(pairs[:MAX_LISTED], dist[:MAX_LISTED], strict=True)]
     message = (f"{len(pairs)} pair(s) of nodes nearly coincide but no element, spring or"
-               f" link joins them, so the model is split there: {_listed(named)}; merge"
+               f" link joins them, so the model is split there: {_listed(named, len(pairs))};"
+               " merge"
                " them (Mesh.merge_nodes(tol), scene key merge_nodes) or join them")
     return [Finding("near nodes", message, np.unique(pairs))]
 

@@ -347,3 +347,24 @@ def test_scene_merge_refuses_node_indices():
     found = prepare(Scene.from_dict(tomllib.loads(scene_text(1e-6)))).findings["frame"]
     assert [f.kind for f in found] == ["near nodes"]
     assert found[0].nodes.tolist() == [1, 2]
+
+
+def test_near_nodes_of_a_dense_cluster_stay_cheap():
+    # 3 000 coincident node pairs stacked on one point make 4.5 million pairs closer than
+    # the tolerance; the check must name the nodes without listing every pair (it took
+    # 29 s and gigabytes for a 10-million-pair mesh before)
+    from femmech import checks
+
+    rng = np.random.default_rng(0)
+    n = 3000
+    cluster = rng.normal(scale=1e-9, size=(n, 3))
+    far = np.array([[1.0, 0.0, 0.0]])
+    points = np.vstack([cluster, far])
+    lines = np.column_stack([np.arange(n), np.full(n, n)])  # every node to the far node
+    pairs, dist = checks.near_nodes(points, {"line": lines})
+    assert len(pairs) <= checks.K_NEAREST * n
+    assert set(np.unique(pairs)) == set(range(n))  # every clustered node is named
+    assert np.all(dist < 1e-4)
+    found = checks.near_node_findings(points, {"line": lines})
+    assert len(found) == 1 and "and" in found[0].message
+    assert found[0].message.count("apart") == checks.MAX_LISTED
