@@ -131,7 +131,8 @@ def test_cache_info_and_clear(scene, tmp_path, capsys):
     assert main(["cache", "info", "--cache-dir", str(cache)]) == 0
     info = capsys.readouterr().out
     assert f"reduction cache {cache}" in info
-    assert "1 entry," in info and "1 other files" in info
+    assert "1 entry," in info
+    assert "1 other files" in info
     assert main(["cache", "clear", "--cache-dir", str(cache)]) == 0
     assert "removed" in capsys.readouterr().out
     assert [p.name for p in cache.iterdir()] == ["notes.txt"]

@@ -149,10 +149,12 @@ def test_cli_run_needs_allow_code(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["run", str(path), "--out", str(out), "--no-cache"]) == INPUT
     assert "--allow-code" in one_line(capsys.readouterr().err)
-    assert not (tmp_path / "ran.txt").exists() and not out.exists()
+    assert not (tmp_path / "ran.txt").exists()
+    assert not out.exists()
     assert main(["run", str(path), "--out", str(out), "--no-cache", "--allow-code", "-q"]) == 0
     assert (tmp_path / "ran.txt").exists()
-    assert (out / "report.html").is_file() and (out / "quasi_frequencies.csv").is_file()
+    assert (out / "report.html").is_file()
+    assert (out / "quasi_frequencies.csv").is_file()
 
 
 @pytest.mark.parametrize("where", ["parent", "absolute", "symlink"])
@@ -249,7 +251,8 @@ def test_two_runs_into_one_folder_leave_the_second_set(tmp_path):
     import json
     listed = set(json.loads((out / MANIFEST).read_text())["files"])
     assert files == listed | {MANIFEST, "my_notes.txt"}
-    assert second.report == out / "report.html" and first.out_dir == second.out_dir
+    assert second.report == out / "report.html"
+    assert first.out_dir == second.out_dir
     assert "scene b.toml" in (out / "report.html").read_text()
     assert not [p for p in tmp_path.iterdir() if ".femmech-" in p.name]
 
@@ -339,7 +342,8 @@ def test_internal_error_exits_1_with_traceback_only_under_debug(tmp_path, monkey
     args = ["run", str(frame_scene(tmp_path)), "--out", str(tmp_path / "o"), "--no-cache"]
     assert main(args) == INTERNAL
     err = one_line(capsys.readouterr().err)
-    assert err.startswith("internal error: KeyError") and "--debug" in err
+    assert err.startswith("internal error: KeyError")
+    assert "--debug" in err
     assert main([*args, "--debug"]) == INTERNAL
     assert "Traceback (most recent call last)" in capsys.readouterr().err
 

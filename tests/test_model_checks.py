@@ -366,5 +366,6 @@ def test_near_nodes_of_a_dense_cluster_stay_cheap():
     assert set(np.unique(pairs)) == set(range(n))  # every clustered node is named
     assert np.all(dist < 1e-4)
     found = checks.near_node_findings(points, {"line": lines})
-    assert len(found) == 1 and "and" in found[0].message
+    assert len(found) == 1
+    assert "and" in found[0].message
     assert found[0].message.count("apart") == checks.MAX_LISTED
