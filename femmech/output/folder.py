@@ -17,6 +17,7 @@ import json
 import os
 import secrets
 import shutil
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -35,12 +36,23 @@ def _siblings(out: Path) -> list[Path]:
     return [p for p in out.parent.iterdir() if p.name.startswith(prefix)]
 
 
-def _alive(pid: int) -> bool:
+STALE_AGE = 24 * 3600.0
+"""s; where a process cannot be asked whether it still runs (Windows, where signal 0 is
+Ctrl-C), a staging folder older than this counts as left by a killed run."""
+
+
+def _alive(pid: int, path: Path) -> bool:
+    """Whether the run that made ``path`` may still be running."""
+    if os.name == "nt":  # os.kill(pid, 0) would send CTRL_C_EVENT there
+        try:
+            return time.time() - path.stat().st_mtime < STALE_AGE
+        except OSError:
+            return False
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
-    except (PermissionError, OSError):
+    except OSError:  # e.g. another user's process: leave its folder alone
         return True
     return True
 
@@ -52,7 +64,7 @@ def _remove_stale(out: Path) -> None:
             pid = int(path.name.rsplit("-", 2)[-2])
         except (ValueError, IndexError):
             continue
-        if pid != os.getpid() and not _alive(pid):
+        if pid != os.getpid() and not _alive(pid, path):
             shutil.rmtree(path, ignore_errors=True)
 
 
