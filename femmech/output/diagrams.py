@@ -75,6 +75,17 @@ def write_sweep_json(sweep, filename, metadata: dict | None = None) -> Path:
 _LOOSE_LABEL = "not converged (value unreliable)"
 
 
+def chart_legend(unstable: np.ndarray, loose: np.ndarray) -> str:
+    """What the shading of a stability chart shows, for its title: only what is drawn."""
+    if unstable.any():
+        parts = ["shaded: unstable"]
+    else:
+        parts = ["no converged point unstable" if loose.any() else "stable at every point"]
+    if loose.any():
+        parts.append("hatched: not converged, no verdict")
+    return "; ".join(parts)
+
+
 def stability_figure(chart, title: str = "Floquet stability", speed_label: str | None = None,
                      marks: dict | None = None, quantity: str = "radius",
                      speed_unit: str = "rad/s"):
@@ -140,7 +151,7 @@ def stability_figure(chart, title: str = "Floquet stability", speed_label: str |
                     xytext=(-2, -4), textcoords="offset points", rotation=90, va="top",
                     ha="right", fontsize=7)
     ax.set_xlabel(speed_label)
-    ax.set_title(f"{title} (shaded: unstable)")
+    ax.set_title(f"{title} ({chart_legend(unstable, loose)})")
     handles, labels = ax.get_legend_handles_labels()
     if handles:
         unique = dict(zip(labels, handles, strict=True))
