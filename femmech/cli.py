@@ -48,6 +48,7 @@ def _parser() -> argparse.ArgumentParser:
         " requested analyses with cached reductions and write an HTML report.",
         epilog="exit codes: " + "; ".join(f"{k} {v}" for k, v in EXIT_CODES.items()))
     parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
+    parser.add_argument("--version", action="version", version=f"femmech {_version()}")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="compute a scene and write its report")
     run.add_argument("scene", type=Path, help="scene file (.toml)")
@@ -79,6 +80,12 @@ def _parser() -> argparse.ArgumentParser:
     cache.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                        help="show the traceback of an error")
     return parser
+
+
+def _version() -> str:
+    from femmech import __version__
+
+    return __version__
 
 
 def _code_options(parser, help_allow: str) -> None:

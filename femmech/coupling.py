@@ -122,6 +122,12 @@ class CoupledSystem:
     labels: tuple
     H: np.ndarray | None = None
 
+    def __repr__(self) -> str:
+        kind = type(self.frame).__name__
+        return (f"CoupledSystem({self.n} coordinates: {kind} frame with {self.n_frame},"
+                f" {len(self.mounts)} mounted mechanism(s) with {self.n - self.n_frame};"
+                f" {'sparse' if self.is_sparse else 'dense'})")
+
     @property
     def n(self) -> int:
         """Number of global coordinates."""

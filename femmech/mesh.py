@@ -93,6 +93,11 @@ class Mesh:
             node_sets[name] = nodes
         object.__setattr__(self, "node_sets", node_sets)
 
+    def __repr__(self) -> str:
+        cells = ", ".join(f"{len(c)} {k}" for k, c in self.cells.items()) or "no cells"
+        return (f"Mesh({self.n_nodes} nodes; {cells}; {len(self.cell_sets)} cell sets,"
+                f" {len(self.node_sets)} node sets)")
+
     @property
     def n_nodes(self) -> int:
         """Number of nodes."""

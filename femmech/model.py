@@ -150,6 +150,11 @@ class FEModel:
     solids: SolidSet = field(default_factory=SolidSet)
     inactive: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))
 
+    def __repr__(self) -> str:
+        kinds = ", ".join(f"{len(c)} {k}" for k, c in self.mesh.cells.items())
+        return (f"FEModel({self.mesh.n_nodes} nodes, {kinds}; {self.n_dof} DOFs,"
+                f" {self.n_free} free; K, M sparse with {self.K_free.nnz} non-zeros)")
+
     @property
     def n_dof(self) -> int:
         """Number of DOFs before constraints (6 per node)."""

@@ -98,6 +98,13 @@ class Superelement:
     n_residual: int = 0
     interior_factor: object = field(default=None, compare=False, repr=False)
 
+    def __repr__(self) -> str:
+        modal = f", {self.n_modal} modal" if self.n_modal else ""
+        residual = f" ({self.n_residual} residual vectors)" if self.n_residual else ""
+        return (f"Superelement({self.method}: {self.n_reduced} coordinates ="
+                f" {self.n_interface} interface DOFs{modal}{residual}; full model"
+                f" {self.n_dof} DOFs)")
+
     @property
     def n_interface(self) -> int:
         """Number of physical interface DOFs n_b."""

@@ -136,3 +136,12 @@ def test_cache_info_and_clear(scene, tmp_path, capsys):
     assert main(["cache", "clear", "--cache-dir", str(cache)]) == 0
     assert "removed" in capsys.readouterr().out
     assert [p.name for p in cache.iterdir()] == ["notes.txt"]
+
+
+def test_version(capsys):
+    import femmech
+
+    with pytest.raises(SystemExit) as info:
+        main(["--version"])
+    assert info.value.code == 0
+    assert capsys.readouterr().out.strip() == f"femmech {femmech.__version__}"

@@ -58,6 +58,12 @@ class ModeSet:
     error_estimate: np.ndarray | None = None
     solver: str | None = None
 
+    def __repr__(self) -> str:
+        f = np.asarray(self.freq_hz)
+        shown = ", ".join(f"{x:.4g}" for x in f[:6]) + (", ..." if f.size > 6 else "")
+        rigid = f", {int(np.sum(self.rigid))} rigid-body" if np.any(self.rigid) else ""
+        return f"ModeSet({f.size} modes{rigid}: [{shown}] Hz; {self.method})"
+
     @property
     def n_modes(self) -> int:
         """Number of modes."""

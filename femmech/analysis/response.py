@@ -72,6 +72,13 @@ class Response:
     converged: bool | None = None
     n_steps: int | None = None
 
+    def __repr__(self) -> str:
+        t = np.asarray(self.t)
+        state = ("" if self.converged is None else
+                 f"; error {self.error:.1e}" + ("" if self.converged else " NOT CONVERGED"))
+        return (f"Response({t.size} times {t[0]:.4g}..{t[-1]:.4g} s, {np.shape(self.q)[-1]}"
+                f" coordinates{state})")
+
 
 @dataclass(frozen=True)
 class ConstantSpeed:

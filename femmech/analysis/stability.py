@@ -301,6 +301,15 @@ class StabilityChart:
     n_steps: np.ndarray | None = None
     rtol: float | None = None
 
+    def __repr__(self) -> str:
+        n_unstable = int(np.sum(~np.asarray(self.stable) & ~self.unconverged))
+        loose = int(np.sum(self.unconverged))
+        grid = f"{len(self.speeds)} speeds" + (f" x {len(self.values)} {self.parameter_name}"
+                                               if self.values is not None else "")
+        flags = f", {loose} NOT CONVERGED" if loose else ""
+        return (f"StabilityChart({grid}; max spectral radius"
+                f" {np.nanmax(self.spectral_radius):.6g}, {n_unstable} unstable{flags})")
+
     @property
     def unconverged(self) -> np.ndarray:
         """Mask (n_values, n_speeds) of points that missed their tolerance."""

@@ -91,6 +91,13 @@ class Sweep:
     mac_step: np.ndarray
     form: str
 
+    def __repr__(self) -> str:
+        phi = np.rad2deg(np.asarray(self.phi))
+        f = np.asarray(self.freq_hz)
+        band = f"{np.nanmin(f):.4g}..{np.nanmax(f):.4g} Hz" if f.size else "-"
+        return (f"Sweep({phi.size} angles {phi.min():.4g}..{phi.max():.4g} deg,"
+                f" {f.shape[-1]} branches over {band}; {self.form})")
+
     @property
     def unstable(self) -> np.ndarray:
         """(n_angles, n_modes) bool: the branch's frozen-angle motion grows (flutter,
