@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import os
 import re
 import time
@@ -60,6 +61,8 @@ reduction). Then the reduction is built here too, without storing it (CacheWarni
 STALE_AGE = 3600.0
 """Age, s, beyond which a temporary file counts as left by a killed run even while its
 key's lock is held (a write takes seconds; a writer that holds the lock longer is hung)."""
+
+_LOG = logging.getLogger("femmech.cache")
 
 DEFAULT_MAX_BYTES = 2 * 1024**3
 """Default size limit of the cache folder's entries, bytes (2 GiB)."""
@@ -245,7 +248,7 @@ def _remove(*paths: Path) -> int:
 
 
 def cached_reduction(folder, key: str, label: str, build: Callable[[], Superelement],
-                     log: Callable[[str], None] = print, max_bytes: int | None = None,
+                     log: Callable[[str], None] | None = None, max_bytes: int | None = None,
                      lock_timeout: float = LOCK_TIMEOUT) -> CachedReduction:
     """Load the reduction ``key`` from ``folder`` or build and store it.
 
@@ -256,6 +259,7 @@ def cached_reduction(folder, key: str, label: str, build: Callable[[], Superelem
     naming the folder, the entry and the problem; the run goes on with the result of
     ``build``. Waits up to ``lock_timeout`` s for another process building the same key.
     """
+    log = log or _LOG.info
     start = time.perf_counter()
     short = key[:12]
     if folder is None:

@@ -28,8 +28,10 @@ runs it.
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 import traceback
+from contextlib import contextmanager
 from pathlib import Path
 
 from femmech.errors import InputError, NumericalError
@@ -61,8 +63,10 @@ def _parser() -> argparse.ArgumentParser:
                      " ~/.cache/femmech)")
     _code_options(run, "run the Python modules the scene names (module = ...); only for"
                   " scenes from authors you trust")
-    run.add_argument("-q", "--quiet", action="store_true", help="no log lines, no progress"
-                     " bars")
+    run.add_argument("-q", "--quiet", action="store_true", help="only warnings and the"
+                     " report's path; no progress bars")
+    run.add_argument("-v", "--verbose", action="store_true", help="also debug messages of"
+                     " the library (logger 'femmech')")
     run.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                      help="show the traceback of an error")
     check = sub.add_parser("check", help="validate a scene without computing (never runs"
@@ -122,12 +126,30 @@ def _run(args) -> int:
 
     cache = None if args.no_cache else (args.cache_dir or default_cache_dir())
     bars = not args.quiet and sys.stderr.isatty()
-    result = run_scene(args.scene, args.out, cache_dir=cache,
-                       log=None if args.quiet else print, bars=bars,
-                       allow_code=args.allow_code, code_root=args.code_root)
+    level = logging.WARNING if args.quiet else logging.DEBUG if args.verbose else logging.INFO
+    with _logging_to_stdout(level):
+        result = run_scene(args.scene, args.out, cache_dir=cache, bars=bars,
+                           allow_code=args.allow_code, code_root=args.code_root)
     if args.quiet:
         print(result.report)
     return OK
+
+
+@contextmanager
+def _logging_to_stdout(level: int):
+    """The messages of the ``femmech`` loggers at ``level`` and above, one per line on
+    stdout, while the block runs (library code logs; only the command line prints)."""
+    handler = logging.StreamHandler(sys.stdout)
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    logger = logging.getLogger("femmech")
+    old_level = logger.level
+    logger.addHandler(handler)
+    logger.setLevel(level)
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(old_level)
 
 
 def _cache(args) -> int:

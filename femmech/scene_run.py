@@ -12,6 +12,7 @@ and the files of each analysis."""
 from __future__ import annotations
 
 import json
+import logging
 import sys
 import time
 import warnings
@@ -41,6 +42,11 @@ from femmech.scene_build import (
     sha256_key,
 )
 from femmech.substructures import assemble_parts
+
+LOG = logging.getLogger("femmech.run")
+"""Every line of a run's log (``run.log``) also goes here: INFO, and WARNING for the
+``warning:`` lines (suspicious inputs, cache problems). ``femmech run`` shows INFO
+and above (``-q``: WARNING and above, ``-v``: everything)."""
 
 DEFAULT = object()
 """Marker: use :func:`femmech.cache.default_cache_dir`."""
@@ -182,7 +188,8 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
     cache_dir : path or None
         Reduction cache; default :func:`femmech.cache.default_cache_dir`, None: no cache.
     log : callable, optional
-        Also receives each log line as it happens (e.g. ``print``).
+        Also receives each log line as it happens (e.g. ``print``); the lines always go
+        to the logger ``femmech.run`` (:data:`LOG`) as well.
     bars : bool
         tqdm progress bars for the long steps.
     allow_code : bool
@@ -211,6 +218,7 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
 
     def emit(line: str) -> None:
         lines.append(line)
+        LOG.log(logging.WARNING if line.startswith("warning:") else logging.INFO, line)
         if log is not None:
             log(line)
 
@@ -232,6 +240,7 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
             results[kind] = numbers
             emit(f"{kind}: done in {ws.timings[f'analysis {kind}']:.2f} s")
         ws.timings["total"] = time.perf_counter() - start
+        LOG.debug("timings (s): " + ", ".join(f"{k} {v:.3f}" for k, v in ws.timings.items()))
         sections.insert(0, summary_section(ws))
         _write_json(stage / "results.json", results)
         sections.append(Section("Files", files=("results.json", "run.log")))

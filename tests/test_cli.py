@@ -145,3 +145,20 @@ def test_version(capsys):
         main(["--version"])
     assert info.value.code == 0
     assert capsys.readouterr().out.strip() == f"femmech {femmech.__version__}"
+
+
+def test_verbosity_through_logging(scene, tmp_path, capsys):
+    # library code logs (logger 'femmech'); the command line shows INFO, -q only warnings
+    # and the report's path, -v also the DEBUG lines (timings)
+    args = ["run", str(scene), "--no-cache"]
+    assert main([*args, "--out", str(tmp_path / "a")]) == 0
+    normal = capsys.readouterr().out
+    assert "cache off: part 'frame'" in normal
+    assert "timings (s):" not in normal
+    assert main([*args, "--out", str(tmp_path / "b"), "-v"]) == 0
+    assert "timings (s): prepare" in capsys.readouterr().out
+    assert main([*args, "--out", str(tmp_path / "c"), "-q"]) == 0
+    assert capsys.readouterr().out.strip() == str(tmp_path / "c" / "report.html")
+    import logging
+
+    assert not logging.getLogger("femmech").handlers  # nothing left behind
