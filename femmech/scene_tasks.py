@@ -152,8 +152,7 @@ def run_sweep(ws, spec, out):
                 q = quasi_modes(ws.prepared.mechanisms[spec.mechanism], phi, Omega=W)
                 curves[label] = _Curve(q.phi, q.freq_hz[:, :spec.n_modes], None)
             else:
-                s = sweep(ws.machine(), phi, Omega=W, n_modes=spec.n_modes, track=spec.track,
-                          keep_vectors=bool(spec.mode_images_at))
+                s = sweep(ws.machine(), phi, Omega=W, n_modes=spec.n_modes, track=spec.track)
                 curves[label] = _Curve(s.phi, s.freq_hz, s.vectors)
     what = f"mechanism {spec.mechanism!r} alone" if spec.mechanism else "coupled machine"
     plot_quasi_frequencies(curves, out / "quasi_frequencies.png",
@@ -170,7 +169,7 @@ def run_sweep(ws, spec, out):
                        for label, c in curves.items() for k in range(n))
     figures = [Figure("quasi_frequencies.png", f"Quasi-eigenfrequencies of the {what}")]
     for angle in spec.mode_images_at:
-        figures.append(_coupled_image(ws, curves[next(iter(curves))], angle, out))
+        figures.append(_coupled_image(ws, spec, angle, out))
     text = (f"{phi.size} drive angles from {np.rad2deg(phi[0]):.1f}° to"
             f" {np.rad2deg(phi[-1]):.1f}°, {n} branches, speeds {list(curves)}.",)
     section = Section("Quasi-eigenfrequencies over the drive angle", text,
@@ -190,16 +189,22 @@ class _Curve:
     vectors: np.ndarray | None
 
 
-def _coupled_image(ws, curve, angle, out) -> Figure:
+def _coupled_image(ws, spec, angle: float, out) -> Figure:
+    """The lowest coupled quasi-mode at exactly the requested angle (rad) and the first
+    speed of the sweep: solved there, not taken from the nearest angle of the sweep grid."""
     from femmech.output.machine import plot_coupled_mode
 
-    a = int(np.argmin(np.abs(np.asarray(curve.phi) - angle)))
-    deg = float(np.rad2deg(curve.phi[a]))
-    name = f"coupled_mode_{deg:.0f}deg.png"
+    W = float(spec.speeds[0])
+    at = sweep(ws.machine(), np.array([angle]), Omega=W, n_modes=1, track=False,
+               keep_vectors=True)
+    deg = float(np.rad2deg(angle))
+    name = f"coupled_mode_{deg:g}deg.png".replace(".", "p", 1) if deg != round(deg) else \
+        f"coupled_mode_{deg:.0f}deg.png"
     part = next(iter(ws.scene.parts))
-    plot_coupled_mode(ws.model(part), ws.machine(), curve.vectors[a, :, 0],
-                      curve.freq_hz[a, 0], out / name, angle=curve.phi[a])
-    return Figure(name, f"lowest coupled quasi-mode at {deg:.1f}°: {curve.freq_hz[a, 0]:.2f} Hz")
+    plot_coupled_mode(ws.model(part), ws.machine(), at.vectors[0, :, 0], at.freq_hz[0, 0],
+                      out / name, angle=angle)
+    return Figure(name, f"lowest coupled quasi-mode at φ = {deg:g}°, {W * RPM:.0f} rpm:"
+                  f" {at.freq_hz[0, 0]:.2f} Hz")
 
 
 def _damped(ws, rayleigh):

@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import femmech.scene_tasks as tasks
@@ -357,3 +358,28 @@ def test_full_disk_exits_5(tmp_path, monkeypatch, capsys):
     assert code == FILESYSTEM
     assert "No space left on device" in one_line(capsys.readouterr().err)
     assert not (tmp_path / "o").exists()
+
+
+def test_mode_image_is_drawn_at_the_requested_angle(tmp_path):
+    # the sweep grid (every 60°) does not contain 45° or 22.5°: the image is solved at the
+    # angle asked for, and its file name and caption say so (it used to be the nearest
+    # grid angle, without a word)
+    import tomllib
+
+    from femmech.analysis.sweep import sweep
+    from femmech.scene import Scene
+    from femmech.scene_run import Workshop
+
+    data = tomllib.loads((ROOT / "examples" / "press_frame.toml").read_text())
+    data["analyses"] = {"sweep": {"angles": {"start": "0 deg", "stop": "360 deg", "n": 7},
+                                  "n_modes": 2, "mode_images_at": ["45 deg", "22.5 deg"]}}
+    scene = Scene.from_dict(data, ROOT / "examples", "press_frame.toml")
+    result = run_scene(scene, tmp_path / "out", cache_dir=None)
+    html = result.report.read_text()
+    for name, deg in (("coupled_mode_45deg.png", "45"), ("coupled_mode_22p5deg.png", "22.5")):
+        assert (result.out_dir / name).stat().st_size > 10_000
+        assert f"lowest coupled quasi-mode at φ = {deg}°" in html
+    # the caption's frequency is the solve at 45°, not at the grid's 60°
+    ws = Workshop(prepare(scene), None, lambda line: None, False)
+    at_45 = sweep(ws.machine(), np.deg2rad([45.0]), n_modes=1, track=False).freq_hz[0, 0]
+    assert f"{at_45:.2f} Hz" in html
