@@ -7,6 +7,20 @@ import numpy as np
 from femmech.mesh import MAX_CELLS, MAX_NODES, Mesh
 
 
+def grid_frame_size(bays, subdivisions: int = 1) -> tuple[int, int]:
+    """(nodes, elements) :func:`grid_frame` makes, computed without building it.
+
+    ``bays`` (3 ints >= 0): the joints form a (bx+1)(by+1)(bz+1) grid, each of the
+    bx(by+1)(bz+1) + by(bx+1)(bz+1) + bz(bx+1)(by+1) members between neighbours has
+    ``subdivisions`` elements and so ``subdivisions - 1`` interior nodes. Python ints:
+    no overflow for any request.
+    """
+    bx, by, bz = (int(b) for b in bays)
+    n_members = bx * (by + 1) * (bz + 1) + by * (bx + 1) * (bz + 1) + bz * (bx + 1) * (by + 1)
+    n_joints = (bx + 1) * (by + 1) * (bz + 1)
+    return n_joints + (subdivisions - 1) * n_members, n_members * subdivisions
+
+
 def grid_frame(bays=(2, 2, 2), size=(1.0, 1.0, 1.0), subdivisions: int = 1) -> Mesh:
     """Space frame of beams on a regular grid of joints, members subdivided into elements.
 
@@ -35,12 +49,10 @@ def grid_frame(bays=(2, 2, 2), size=(1.0, 1.0, 1.0), subdivisions: int = 1) -> M
         raise ValueError(f"size must be three positive lengths, got {size}")
     if subdivisions < 1:
         raise ValueError(f"subdivisions must be >= 1, got {subdivisions}")
-    bx, by, bz = bays
-    n_members = bx * (by + 1) * (bz + 1) + by * (bx + 1) * (bz + 1) + bz * (bx + 1) * (by + 1)
-    n_nodes = (bx + 1) * (by + 1) * (bz + 1) + (subdivisions - 1) * n_members
-    if n_nodes > MAX_NODES or n_members * subdivisions > MAX_CELLS:
+    n_nodes, n_elements = grid_frame_size(bays, subdivisions)
+    if n_nodes > MAX_NODES or n_elements > MAX_CELLS:
         raise ValueError(f"grid_frame{bays} with {subdivisions} subdivisions would have"
-                         f" {n_members * subdivisions} elements and {n_nodes} nodes; at most"
+                         f" {n_elements} elements and {n_nodes} nodes; at most"
                          f" {MAX_CELLS} and {MAX_NODES} (MAX_CELLS, MAX_NODES)")
     shape = tuple(b + 1 for b in bays)
     axes = [np.linspace(0.0, s, n) for s, n in zip(size, shape, strict=True)]

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from femmech.checks import NEAR_NODE_TOL
-from femmech.generators import MAX_ELEMENTS_PER_MEMBER
+from femmech.generators import MAX_ELEMENTS_PER_MEMBER, grid_frame_size
 from femmech.mesh import MAX_CELLS, MAX_NODES
 from femmech.scene_reader import Reader, one_line, show
 from femmech.units import LENGTH
@@ -76,12 +76,8 @@ def _grid_frame(g: Reader) -> dict:
                                         maximum=MAX_SUBDIVISIONS, limit="MAX_SUBDIVISIONS")}
     if min(params["size"]) <= 0:
         raise g.error("size", f"expected three positive lengths, got {params['size']}")
-    bx, by, bz = bays
-    k = params["subdivisions"]
-    joints = (bx + 1) * (by + 1) * (bz + 1)
-    members = bx * (by + 1) * (bz + 1) + by * (bx + 1) * (bz + 1) + bz * (bx + 1) * (by + 1)
-    _check_counts(g, "bays", joints, members)
-    _check_counts(g, "subdivisions", joints + (k - 1) * members, members * k)
+    _check_counts(g, "bays", *grid_frame_size(bays))
+    _check_counts(g, "subdivisions", *grid_frame_size(bays, params["subdivisions"]))
     return params
 
 

@@ -13,7 +13,7 @@ from scipy.spatial import cKDTree
 
 import femmech as fm
 from femmech import sections
-from femmech.generators import grid_frame
+from femmech.generators import grid_frame, grid_frame_size
 
 CASES = [((2, 2, 2), 1), ((2, 1, 3), 3), ((3, 0, 0), 2), ((2, 1, 0), 4), ((1, 1, 1), 1)]
 
@@ -106,3 +106,12 @@ def test_a_model_builds_and_has_sensible_modes():
 def test_generator_errors(kwargs, match):
     with pytest.raises(ValueError, match=match):
         grid_frame(**kwargs)
+
+
+@pytest.mark.parametrize(("bays", "subdivisions"), [((1, 1, 1), 1), ((2, 3, 1), 3),
+                                                    ((0, 0, 2), 2), ((3, 0, 0), 1)])
+def test_grid_frame_size_counts_what_grid_frame_builds(bays, subdivisions):
+    # the count the scene checks against MAX_NODES/MAX_CELLS before building anything
+    mesh = grid_frame(bays, (1.0, 1.0, 1.0), subdivisions)
+    n_elements = sum(len(c) for c in mesh.cells.values())
+    assert grid_frame_size(bays, subdivisions) == (mesh.n_nodes, n_elements)
