@@ -383,3 +383,17 @@ def test_mode_image_is_drawn_at_the_requested_angle(tmp_path):
     ws = Workshop(prepare(scene), None, lambda line: None, False)
     at_45 = sweep(ws.machine(), np.deg2rad([45.0]), n_modes=1, track=False).freq_hz[0, 0]
     assert f"{at_45:.2f} Hz" in html
+
+
+@pytest.mark.parametrize("manifest", ["[1, 2]", '"femmech"', "{not json", '{"by": "femmech",'
+                                      ' "files": [1]}', '{"files": ["report.html"]}'])
+def test_a_damaged_run_manifest_makes_the_folder_foreign(tmp_path, manifest):
+    # the manifest is a file in a folder users exchange: a damaged one is never trusted
+    # (and never crashes the run), so the folder counts as not written by femmech
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / MANIFEST).write_text(manifest)
+    (out / "thesis.tex").write_text("precious")
+    with pytest.raises(InputError, match="not empty and was not written by femmech"):
+        run_scene(frame_scene(tmp_path), out, cache_dir=None)
+    assert (out / "thesis.tex").read_text() == "precious"

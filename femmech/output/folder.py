@@ -29,16 +29,15 @@ MANIFEST = ".femmech-run.json"
 
 _TAG = ".femmech-"
 
+STALE_AGE = 24 * 3600.0
+"""s; where a process cannot be asked whether it still runs (Windows, where signal 0 is
+Ctrl-C), a staging folder older than this counts as left by a killed run."""
+
 
 def _siblings(out: Path) -> list[Path]:
     """Staging and retired folders of ``out`` left by earlier runs."""
     prefix = f".{out.name}{_TAG}"
     return [p for p in out.parent.iterdir() if p.name.startswith(prefix)]
-
-
-STALE_AGE = 24 * 3600.0
-"""s; where a process cannot be asked whether it still runs (Windows, where signal 0 is
-Ctrl-C), a staging folder older than this counts as left by a killed run."""
 
 
 def _alive(pid: int, path: Path) -> bool:
@@ -74,9 +73,10 @@ def read_manifest(folder: Path) -> list[str] | None:
         data = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
-    files = data.get("files") if isinstance(data, dict) else None
-    if data.get("by") != "femmech" or not isinstance(files, list) or not all(
-            isinstance(f, str) for f in files):
+    if not isinstance(data, dict) or data.get("by") != "femmech":
+        return None
+    files = data.get("files")
+    if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
         return None
     return files
 
