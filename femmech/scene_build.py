@@ -65,10 +65,11 @@ class Prepared:
     unexecuted: tuple = ()
 
 
-def fail(scene: Scene, where: str, key: str | None, message: str) -> SceneError:
-    """A SceneError at ``[where] key`` of the scene file."""
+def fail(scene: Scene, where: str, key: str | None, message: str,
+         error: type[SceneError] = SceneError) -> SceneError:
+    """A SceneError (or its subclass ``error``) at ``[where] key`` of the scene file."""
     place = f"[{where}]" + (f" {key}" if key else "")
-    return SceneError(f"{scene.file}: {place}: {message}".replace("\n", " "))
+    return error(f"{scene.file}: {place}: {message}".replace("\n", " "))
 
 
 def prepare(scene: Scene, allow_code: bool = False, code_root=None,
@@ -99,10 +100,10 @@ def prepare(scene: Scene, allow_code: bool = False, code_root=None,
         confined_module(scene, spec, code_root)
     if coded and run_code and not allow_code:
         spec = coded[0]
-        raise UserCodeError(str(fail(
-            scene, spec.where, "module", f"{Path(spec.module).name} is Python code; femmech"
-            " runs code named by a scene only with --allow-code (API: allow_code=True). Allow"
-            " it only for scenes from authors you trust; 'femmech check' never runs it")))
+        raise fail(scene, spec.where, "module", f"{Path(spec.module).name} is Python code;"
+                   " femmech runs code named by a scene only with --allow-code (API:"
+                   " allow_code=True). Allow it only for scenes from authors you trust;"
+                   " 'femmech check' never runs it", UserCodeError)
     models = {name: mechanism_model(scene, spec, code_root)
               for name, spec in scene.mechanisms.items()
               if run_code or spec.module is None}

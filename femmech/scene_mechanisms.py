@@ -102,8 +102,7 @@ def position_function(scene, p):
 
 def code_error(scene, spec, key: str, message: str) -> UserCodeError:
     """A one-line UserCodeError at ``[mechanisms.<name>] key``."""
-    error = fail(scene, spec.where, key, message)
-    return UserCodeError(str(error))
+    return fail(scene, spec.where, key, message, UserCodeError)
 
 
 def confined_module(scene, spec, code_root=None) -> Path:

@@ -254,8 +254,9 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
     return RunResult(final, final / report.name, results, tuple(lines), dict(ws.timings))
 
 
-NUMERICAL_FAILURES = (RuntimeError, np.linalg.LinAlgError, FloatingPointError, ArithmeticError)
-"""Exceptions of a computation on valid input; reported as NumericalError."""
+NUMERICAL_FAILURES = (RuntimeError, np.linalg.LinAlgError, ArithmeticError)
+"""Exceptions of a computation on valid input (ArithmeticError includes FloatingPointError
+and OverflowError); reported as NumericalError."""
 
 
 def _analysis(ws: Workshop, kind: str, out: Path):
