@@ -51,38 +51,39 @@ def _parser() -> argparse.ArgumentParser:
         epilog="exit codes: " + "; ".join(f"{k} {v}" for k, v in EXIT_CODES.items()))
     parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
     parser.add_argument("--version", action="version", version=f"femmech {_version()}")
+    # options every command takes (--debug also after the command: SUPPRESS keeps the
+    # top-level value when it is not given there)
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                        help="show the traceback of an error")
+    code_root = argparse.ArgumentParser(add_help=False)
+    code_root.add_argument("--code-root", type=Path, default=None, help="folder the scene's"
+                           " Python modules may lie in (default: the scene's folder)")
+    cache_dir = argparse.ArgumentParser(add_help=False)
+    cache_dir.add_argument("--cache-dir", type=Path, default=None,
+                           help="reduction cache folder (default: $FEMMECH_CACHE_DIR, else"
+                           " ~/.cache/femmech)")
     sub = parser.add_subparsers(dest="command", required=True)
-    run = sub.add_parser("run", help="compute a scene and write its report")
+    run = sub.add_parser("run", help="compute a scene and write its report",
+                         parents=[common, code_root, cache_dir])
     run.add_argument("scene", type=Path, help="scene file (.toml)")
     run.add_argument("--out", type=Path, required=True, help="output folder (created; an"
                      " existing one must be empty or hold an earlier run, which is replaced)")
     run.add_argument("--no-cache", action="store_true", help="do not read or write the"
                      " reduction cache")
-    run.add_argument("--cache-dir", type=Path, default=None,
-                     help="reduction cache folder (default: $FEMMECH_CACHE_DIR, else"
-                     " ~/.cache/femmech)")
-    _code_options(run, "run the Python modules the scene names (module = ...); only for"
-                  " scenes from authors you trust")
+    run.add_argument("--allow-code", action="store_true", help="run the Python modules the"
+                     " scene names (module = ...); only for scenes from authors you trust")
     run.add_argument("-q", "--quiet", action="store_true", help="only warnings and the"
                      " report's path; no progress bars")
     run.add_argument("-v", "--verbose", action="store_true", help="also debug messages of"
                      " the library (logger 'femmech')")
-    run.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                     help="show the traceback of an error")
     check = sub.add_parser("check", help="validate a scene without computing (never runs"
-                           " the scene's Python code)")
+                           " the scene's Python code)", parents=[common, code_root])
     check.add_argument("scene", type=Path, help="scene file (.toml)")
-    check.add_argument("--code-root", type=Path, default=None, help="folder the scene's"
-                       " Python modules may lie in (default: the scene's folder)")
-    check.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                       help="show the traceback of an error")
-    cache = sub.add_parser("cache", help="show or empty the reduction cache")
+    cache = sub.add_parser("cache", help="show or empty the reduction cache",
+                           parents=[common, cache_dir])
     cache.add_argument("action", choices=("info", "clear"), help="info: entries, size, limit"
                        " and last use; clear: remove femmech's entries (other files stay)")
-    cache.add_argument("--cache-dir", type=Path, default=None,
-                       help="cache folder (default: $FEMMECH_CACHE_DIR, else ~/.cache/femmech)")
-    cache.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                       help="show the traceback of an error")
     return parser
 
 
@@ -90,12 +91,6 @@ def _version() -> str:
     from femmech import __version__
 
     return __version__
-
-
-def _code_options(parser, help_allow: str) -> None:
-    parser.add_argument("--allow-code", action="store_true", help=help_allow)
-    parser.add_argument("--code-root", type=Path, default=None, help="folder the scene's"
-                        " Python modules may lie in (default: the scene's folder)")
 
 
 def _check(args) -> int:
@@ -183,7 +178,8 @@ def main(argv=None) -> int:
         name = args.scene.name if args.command != "cache" else "cache"
         if code == INPUT:
             text = _one_line(exc)
-            message = f"error: {text}" if text.startswith(name) else f"error: {name}: {text}"
+            named = text.startswith((name, str(getattr(args, "scene", name))))
+            message = f"error: {text}" if named else f"error: {name}: {text}"
         elif code == NUMERICAL:
             message = f"numerical failure: {_one_line(exc)}"
         elif code == FILESYSTEM:
