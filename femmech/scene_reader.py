@@ -58,11 +58,18 @@ def one_line(text: str) -> str:
     return text.translate(_LINE_BREAKS)
 
 
+def closest(word, names) -> str | None:
+    """The name of ``names`` nearest to ``word`` (difflib ratio >= 0.6), for a "did you
+    mean"; None if none is near."""
+    close = difflib.get_close_matches(str(word), [str(n) for n in names], n=1, cutoff=0.6)
+    return close[0] if close else None
+
+
 def unknown_key_message(key, allowed, context: str = "") -> str:
     """``unknown key[ context]; did you mean 'x'? expected one of [...]``."""
     names = sorted(str(a) for a in allowed)
-    close = difflib.get_close_matches(str(key), names, n=1, cutoff=0.6)
-    hint = f" did you mean {close[0]!r}?" if close else ""
+    near = closest(key, names)
+    hint = f" did you mean {near!r}?" if near else ""
     context = f" {context}" if context else ""
     return f"unknown key{context};{hint} expected one of {names}"
 
@@ -244,8 +251,8 @@ class Reader:
         if not isinstance(value, str):
             raise self.error(key, f"expected a string, got {show(value)}")
         if choices is not None and value not in choices:
-            close = difflib.get_close_matches(value, list(choices), n=1, cutoff=0.6)
-            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            near = closest(value, choices)
+            hint = f" (did you mean {near!r}?)" if near else ""
             raise self.error(key, f"expected one of {sorted(choices)}, got"
                                   f" {show(value)}{hint}")
         return value
