@@ -210,7 +210,7 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
     NumericalError
         When a computation on a valid scene fails (naming the analysis).
     """
-    from femmech.output.folder import staged_output
+    from femmech.output.folder import output_path, staged_output
     from femmech.scene_tasks import TASKS, summary_section
 
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
@@ -226,7 +226,7 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
     start = time.perf_counter()
     prepared = prepare(scene, allow_code=allow_code, code_root=code_root)
     with staged_output(out) as stage:
-        final = Path(out).expanduser().absolute()
+        final = output_path(out)
         ws = Workshop(prepared, cache, emit, bars)
         ws.timings["prepare"] = time.perf_counter() - start
         for line in finding_lines(prepared):

@@ -81,10 +81,15 @@ def read_manifest(folder: Path) -> list[str] | None:
     return files
 
 
+def output_path(out) -> Path:
+    """The absolute path of the output folder ``out`` (``~`` expanded, links kept)."""
+    return Path(out).expanduser().absolute()
+
+
 def check_output_folder(out) -> Path:
     """The absolute output folder, or InputError naming it if it cannot be used: it is a
     file, or a non-empty folder without a femmech manifest."""
-    out = Path(out).expanduser().absolute()
+    out = output_path(out)
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out}: exists and is not a folder")
     if out.is_dir() and any(out.iterdir()) and read_manifest(out) is None:
