@@ -150,10 +150,10 @@ def run_sweep(ws, spec, out):
         with ws.timed("sweep"):
             if spec.mechanism is not None:
                 q = quasi_modes(ws.prepared.mechanisms[spec.mechanism], phi, Omega=W)
-                curves[label] = _Curve(q.phi, q.freq_hz[:, :spec.n_modes], None)
+                curves[label] = _Curve(q.phi, q.freq_hz[:, :spec.n_modes])
             else:
                 s = sweep(ws.machine(), phi, Omega=W, n_modes=spec.n_modes, track=spec.track)
-                curves[label] = _Curve(s.phi, s.freq_hz, s.vectors)
+                curves[label] = _Curve(s.phi, s.freq_hz)
     what = f"mechanism {spec.mechanism!r} alone" if spec.mechanism else "coupled machine"
     plot_quasi_frequencies(curves, out / "quasi_frequencies.png",
                            title=f"{ws.scene.name}: {what}")
@@ -182,11 +182,10 @@ def run_sweep(ws, spec, out):
 
 @dataclass(frozen=True)
 class _Curve:
-    """phi (rad), freq_hz and vectors (or None) of one sweep, for plot_quasi_frequencies."""
+    """phi (rad) and freq_hz of one sweep, for plot_quasi_frequencies."""
 
     phi: np.ndarray
     freq_hz: np.ndarray
-    vectors: np.ndarray | None
 
 
 def _coupled_image(ws, spec, angle: float, out) -> Figure:
@@ -198,8 +197,7 @@ def _coupled_image(ws, spec, angle: float, out) -> Figure:
     at = sweep(ws.machine(), np.array([angle]), Omega=W, n_modes=1, track=False,
                keep_vectors=True)
     deg = float(np.rad2deg(angle))
-    name = f"coupled_mode_{deg:g}deg.png".replace(".", "p", 1) if deg != round(deg) else \
-        f"coupled_mode_{deg:.0f}deg.png"
+    name = "coupled_mode_" + f"{deg:g}".replace(".", "p") + "deg.png"  # 22.5° → 22p5deg
     part = next(iter(ws.scene.parts))
     plot_coupled_mode(ws.model(part), ws.machine(), at.vectors[0, :, 0], at.freq_hz[0, 0],
                       out / name, angle=angle)
