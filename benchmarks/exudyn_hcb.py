@@ -29,7 +29,7 @@ What each library reduces, and how the two are made the same reduction:
   of equal frequencies; Exudyn is asked for the same number as femmech kept.
 
 Each library runs twice: with the BLAS/OpenMP threads as the process has them (femmech
-applies its own per-phase limits, femmech.threads) and inside ``threadpool_limits(1)``.
+applies its own per-phase limits, femmech.solve.threads) and inside ``threadpool_limits(1)``.
 Exudyn factorises K_ii twice with scipy's default SuperLU (``factorized`` for the static
 modes, ``eigsh(sigma=0)`` for the fixed-interface modes); femmech factorises once with the
 solver ``auto`` picks. Agreement: the lowest 20 frequencies of the two reduced models
@@ -58,7 +58,7 @@ import numpy as np
 import scipy.linalg as sla
 from threadpoolctl import threadpool_limits
 
-from femmech import reduction
+from femmech.reduction import reduce as reduction
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from craig_bampton import (  # noqa: E402  (sibling benchmark: models and helpers)

@@ -1,7 +1,7 @@
 """Benchmark: assembly and 20-mode eigen solve of grid space frames, 10k to 1M DOFs.
 
 Models are machine-frame-like grids of hollow-section steel members
-(:func:`femmech.generators.grid_frame`, bay 0.5 m, 80 x 80 x 5 mm box section), every
+(:func:`femmech.fe.generators.grid_frame`, bay 0.5 m, 80 x 80 x 5 mm box section), every
 member subdivided into several Timoshenko elements, supported at the base joints (one
 free-free variant). For each model the benchmark prints
 
@@ -50,13 +50,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 import femmech as fm
-import femmech.linalg
-import femmech.model
-import femmech.threads
-from femmech import sections
-from femmech.dofs import element_dofs
-from femmech.elements.beam import beam_matrices
-from femmech.generators import grid_frame
+import femmech.fe.model
+import femmech.solve.eigen
+import femmech.solve.threads
+from femmech.fe import sections
+from femmech.fe.dofs import element_dofs
+from femmech.fe.elements.beam import beam_matrices
+from femmech.fe.generators import grid_frame
 from femmech.output.export import atomic_path
 
 N_MODES = 20
@@ -215,8 +215,8 @@ def build(mesh, supported: bool):
     supports = [fm.Support("base")] if supported else []
     timer = PhaseTimer()
     row = {}
-    targets = [(femmech.model, "beam_matrices", "element"),
-               (femmech.model, "assemble", "coo_csr")]
+    targets = [(femmech.fe.model, "beam_matrices", "element"),
+               (femmech.fe.model, "assemble", "coo_csr")]
     with peak_memory(row, "build_peak_mb"), timer.patched(targets):
         start = time.perf_counter()
         model = fm.build_model(mesh, dict.fromkeys(GROUPS, prop), supports=supports)
@@ -237,10 +237,10 @@ def solve(model):
     """``fm.modes(model, 20)`` with factorisation, Lanczos and Sturm check timed."""
     timer = PhaseTimer()
     row = {}
-    targets = [(femmech.linalg, "inertia_below", "sturm"),
-               (femmech.linalg, "factorize", "factor"),
-               (femmech.linalg, "_arpack", "arpack"),  # bands
-               (femmech.linalg, "_block_lanczos", "arpack")]  # lowest modes
+    targets = [(femmech.solve.eigen, "inertia_below", "sturm"),
+               (femmech.solve.eigen, "factorize", "factor"),
+               (femmech.solve.eigen, "_arpack", "arpack"),  # bands
+               (femmech.solve.eigen, "_block_lanczos", "arpack")]  # lowest modes
     with peak_memory(row, "eigen_peak_mb"), timer.patched(targets):
         start = time.perf_counter()
         result = fm.modes(model, n_modes=N_MODES)
@@ -290,7 +290,7 @@ def counted_eigsh(K, M, k: int, sigma: float, factor, return_eigenvectors: bool 
         return factor.solve(x)
 
     op = spla.LinearOperator((n, n), matvec=solve, dtype=float)
-    with femmech.threads.solve_phase():
+    with femmech.solve.threads.solve_phase():
         result = spla.eigsh(K, k=k, M=M, sigma=sigma, which="LM", OPinv=op, v0=np.ones(n),
                             tol=0, return_eigenvectors=return_eigenvectors)
     omega2 = result[0] if return_eigenvectors else result
@@ -326,7 +326,7 @@ def _reference(model, solved, solver, with_slow, timing_history):
     omega2_ref, seconds = reference_frequencies(model, solved["sigma"], solver)
     if solver == "eigsh":
         timing_history.append((n, seconds))
-    scale = femmech.linalg.eigenvalue_scale(model.K_free, model.M_free)
+    scale = femmech.solve.eigen.eigenvalue_scale(model.K_free, model.M_free)
     err, rigid_ok = frequency_error(solved["omega2"], omega2_ref, scale)
     row.update(ref_s=seconds, max_rel_err=err, rigid_ok=rigid_ok)
     return row
@@ -344,7 +344,7 @@ def loop_assembly(mesh):
     """Reference: element routine per element in a Python loop, triplets, one COO → CSR."""
     prop_row = _property_arrays()
     lines = mesh.cells["line"]
-    R_orient = femmech.model._orientations(mesh, lines, np.zeros(len(lines), dtype=int),
+    R_orient = femmech.fe.model._orientations(mesh, lines, np.zeros(len(lines), dtype=int),
                                            [fm.BeamProperty(SECTION, STEEL)])
     rows, cols, kv, mv = [], [], [], []
     for e in range(len(lines)):
@@ -366,16 +366,16 @@ def loop_assembly(mesh):
 def vector_assembly(mesh):
     """The vectorised path of ``build_model`` (element matrices + one COO → CSR each)."""
     lines = mesh.cells["line"]
-    orient = femmech.model._orientations(mesh, lines, np.zeros(len(lines), dtype=int),
+    orient = femmech.fe.model._orientations(mesh, lines, np.zeros(len(lines), dtype=int),
                                          [fm.BeamProperty(SECTION, STEEL)])
     Ke, Me = beam_matrices(mesh.points, lines, orient, *_property_arrays())
     edofs = element_dofs(lines)
     n = 6 * mesh.n_nodes
-    return femmech.model.assemble([(edofs, Ke)], n), femmech.model.assemble([(edofs, Me)], n)
+    return femmech.fe.model.assemble([(edofs, Ke)], n), femmech.fe.model.assemble([(edofs, Me)], n)
 
 
 def _property_arrays():
-    row = femmech.model._property_row(fm.BeamProperty(SECTION, STEEL))
+    row = femmech.fe.model._property_row(fm.BeamProperty(SECTION, STEEL))
     E, G, rho, A, Iy, Iz, J, Ip, Asy, Asz, rot, _ = row
     return E, G, rho, A, Iy, Iz, J, Ip, Asy, Asz, bool(rot)
 

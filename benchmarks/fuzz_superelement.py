@@ -82,8 +82,8 @@ FAILURES = OUTCOMES[3:]
 def build_model():
     """A 1 x 1 x 1-bay steel grid frame, clamped at the base, with one rigid link."""
     import femmech as fm
-    from femmech import sections
-    from femmech.generators import grid_frame
+    from femmech.fe import sections
+    from femmech.fe.generators import grid_frame
 
     mesh = grid_frame((1, 1, 1), (1.0, 0.6, 0.8), 2)
     steel = fm.Material(E=210e9, nu=0.3, rho=7850.0)
@@ -97,7 +97,7 @@ def build_model():
 
 def build_superelement():
     """Craig-Bampton superelement of :func:`build_model` on its top joints."""
-    from femmech.reduction import craig_bampton
+    from femmech.reduction.reduce import craig_bampton
 
     return craig_bampton(build_model(), "top", n_modes=4)
 
@@ -173,7 +173,7 @@ def pack(members: dict, compression=zipfile.ZIP_DEFLATED, prefix="") -> bytes:
 
 def craft(members: dict) -> dict:
     """Members with meta's SHA-256 sums recomputed (what an attacker can always do)."""
-    from femmech.superelement_file import field_digest, meta_digest
+    from femmech.reduction.superelement_file import field_digest, meta_digest
 
     try:
         dtype, _, shape, payload = split_npy(members["meta"])
@@ -611,7 +611,7 @@ def identical(se, ref: dict) -> bool:
 
 
 def consistency_problems(se) -> list[str]:
-    """What makes ``se`` unusable, checked independently of femmech.superelement_file."""
+    """What makes ``se`` unusable, checked independently of femmech.reduction.superelement_file."""
     import scipy.linalg as sla
 
     K, M, T, w2 = se.K, se.M, se.T, se.modal_omega2
@@ -668,7 +668,7 @@ def exercise(se):
 
 def judge(task: dict, ref: dict) -> dict:
     from femmech.errors import FileFormatError
-    from femmech.reduction import Superelement
+    from femmech.reduction.reduce import Superelement
 
     path = task["path"]
     start = time.perf_counter()
@@ -701,7 +701,7 @@ def worker_main(reference: str):
     import resource
 
     resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
-    import femmech.reduction  # noqa: F401 (imported before the first timed load)
+    import femmech.reduction.reduce  # noqa: F401 (imported before the first timed load)
 
     ref = reference_fields(reference)
     print("ready", flush=True)

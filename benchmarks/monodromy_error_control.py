@@ -27,9 +27,9 @@ import numpy as np
 from femmech.analysis.response import rayleigh_damping
 from femmech.analysis.stability import coupled_monodromy
 from femmech.errors import ConvergenceWarning
-from femmech.scene import load_scene
-from femmech.scene_build import prepare
-from femmech.scene_run import Workshop
+from femmech.scene.build import prepare
+from femmech.scene.load import load_scene
+from femmech.scene.run import Workshop
 
 HERE = Path(__file__).resolve().parent
 RPM = 2 * np.pi / 60

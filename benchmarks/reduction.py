@@ -1,7 +1,7 @@
 """Benchmark: speed versus error of Guyan and Craig-Bampton reduction of a machine frame.
 
 Model (``large``, the default): a machine-frame-like steel space frame,
-:func:`femmech.generators.grid_frame` with 8 x 4 x 4 bays over 4 m x 2 m x 2 m (bay
+:func:`femmech.fe.generators.grid_frame` with 8 x 4 x 4 bays over 4 m x 2 m x 2 m (bay
 0.5 m), every member subdivided into 16 Timoshenko elements: 51 750 DOFs, hollow
 sections (longitudinals 80 x 120 x 5 mm, cross beams 80 x 80 x 5 mm, columns
 100 x 100 x 6 mm box), fixed at the base joints. Interface: all six DOFs of the top
@@ -50,9 +50,10 @@ import scipy
 import scipy.linalg as sla
 
 import femmech as fm
-from femmech import reduction, sections
-from femmech.generators import grid_frame
+from femmech.fe import sections
+from femmech.fe.generators import grid_frame
 from femmech.output.export import atomic_path
+from femmech.reduction import reduce as reduction
 
 N_MODES = 20
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")

@@ -9,7 +9,7 @@ Runs the entries below one after the other in this process, prints a table per e
 writes it to ``benchmarks/results/<name>.txt`` (atomically). Every table starts with the
 same header: machine (CPU, cores, memory, load average at start and end of the entry),
 library versions (numpy, scipy, scikit-fem, femmech, MKL/PARDISO, scikit-sparse, exudyn)
-and the solver and thread settings (:mod:`femmech.solvers`, :mod:`femmech.threads`).
+and the solver and thread settings (:mod:`femmech.solve.direct`, :mod:`femmech.solve.threads`).
 
 Entries (each reuses the ``main`` of a benchmark module in this folder):
 
@@ -54,8 +54,8 @@ import scipy
 from threadpoolctl import threadpool_limits
 
 import femmech as fm
-from femmech import solvers, threads
 from femmech.output.export import atomic_path
+from femmech.solve import direct, threads
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
@@ -124,12 +124,12 @@ def header(name: str, size: str, load_start, blas_threads) -> list[str]:
     mem_gib = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30
     usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else "?"
     loads = [", ".join(f"{x:.1f}" for x in v) for v in (load_start, os.getloadavg())]
-    pardiso = solvers.mkl_version() if "pardiso" in solvers.available() else None
+    pardiso = direct.mkl_version() if "pardiso" in direct.available() else None
     exudyn = exudyn_hcb.exudyn_version()
     env = ", ".join(f"{k}={os.environ[k]}" for k in (
         "FEMMECH_THREADS", "FEMMECH_SOLVER", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
         "MKL_NUM_THREADS") if k in os.environ) or "no thread/solver variables set"
-    auto_large = solvers.resolve("auto", solvers.AUTO_MIN_SIZE)
+    auto_large = direct.resolve("auto", direct.AUTO_MIN_SIZE)
     return [
         f"benchmark: {name} (suite size {size}), {datetime.datetime.now():%Y-%m-%d %H:%M}",
         f"machine: {cpu}, {cores} cores / {os.cpu_count()} CPUs ({usable} usable),"
@@ -141,10 +141,10 @@ def header(name: str, size: str, load_start, blas_threads) -> list[str]:
         f" {getattr(fm, '__version__', _version('femmech'))}, mkl {_version('mkl')}"
         f" (PARDISO {'available' if pardiso else 'not available'}), scikit-sparse"
         f" {_version('scikit-sparse')}, exudyn {exudyn or 'not installed'}",
-        f"solvers: installed {', '.join(solvers.available())}; default"
-        f" '{solvers.default_solver()}' ('auto' takes {auto_large} from"
-        f" {solvers.AUTO_MIN_SIZE:,} unknowns, SuperLU below); "
-        + "; ".join(f"{k}: {v}" for k, v in solvers.versions().items()),
+        f"solvers: installed {', '.join(direct.available())}; default"
+        f" '{direct.default_solver()}' ('auto' takes {auto_large} from"
+        f" {direct.AUTO_MIN_SIZE:,} unknowns, SuperLU below); "
+        + "; ".join(f"{k}: {v}" for k, v in direct.versions().items()),
         threads.describe(),
         f"suite BLAS limit: {blas_threads or 'none (--blas-threads)'}; environment: {env}",
         ""]

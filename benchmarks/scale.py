@@ -2,7 +2,7 @@
 
 Model (:func:`machine_bed`): a welded machine bed, a rectangular steel box of 6 mm plates
 4.0 m long (x), 0.8 m wide (y), 0.6 m high (z), meshed with flat quads (MITC4 bending +
-membrane + drilling, :mod:`femmech.elements.shell`; ``n`` quads per 0.2 m), stiffened by
+membrane + drilling, :mod:`femmech.fe.elements.shell`; ``n`` quads per 0.2 m), stiffened by
 ring frames (box-section beams 60 x 60 x 5 mm round the perimeter every 0.2 m) and two
 top rails (80 x 80 x 6 mm along the top edges), standing on four feet (all DOFs of the
 bottom-plate nodes within 0.2 m of either end fixed). Sizes ``"tiny"``, ``"small"``,
@@ -24,7 +24,7 @@ Phases, each timed and with its peak resident memory above the start of the phas
 - mesh: generating the quads, beams and spiders;
 - build: ``build_model`` (element matrices of shells and beams, assembly, ``Tᵀ K T``);
 - reduce: ``craig_bampton`` with 30 fixed-interface modes and residual vectors, split as
-  :attr:`~femmech.reduction.Superelement.timings` (factorisation of ``K_ii``, constraint
+  :attr:`~femmech.reduction.reduce.Superelement.timings` (factorisation of ``K_ii``, constraint
   modes, fixed-interface modes with their Sturm check, projection);
 - couple: mounting the four mechanisms on the superelement;
 - sweep: 360 drive angles, 10 tracked branches with mode shapes;
@@ -54,14 +54,15 @@ from pathlib import Path
 import numpy as np
 
 import femmech as fm
-from femmech import sections, solvers, threads
 from femmech.analysis.reference import compare_coupled
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
+from femmech.fe import sections
 from femmech.mechanisms import processing_machine_cams, processing_machine_parameters
 from femmech.mechanisms.models import rheolinear
 from femmech.mechanisms.mounted import cam_follower
-from femmech.reduction import craig_bampton
+from femmech.reduction.reduce import craig_bampton
+from femmech.solve import direct, threads
 
 HERE = Path(__file__).resolve().parent
 LENGTH, WIDTH, HEIGHT = 4.0, 0.8, 0.6  # m: machine bed (x, y, z)
@@ -248,7 +249,7 @@ def format_report(row: dict, header: bool = True) -> list[str]:
     """Plain-text tables of one run, headed (``header``) by machine, versions and threads."""
     lines = fmb.machine_info() + [threads.describe(),
                                   "solvers: " + "; ".join(f"{k}: {v}" for k, v
-                                                          in solvers.versions().items())] \
+                                                          in direct.versions().items())] \
         if header else []
     lines += [f"sparse solver of K_ii: {row['solver']}", ""]
     lines.append(f"Machine bed {LENGTH} x {WIDTH} x {HEIGHT} m, {THICKNESS * 1e3:g} mm plates"

@@ -2,7 +2,7 @@
 
 Models are welded box girders: a rectangular steel tube of four 5 mm plates,
 0.4 m wide (y), 0.6 m high (z) and 2.0 m long (x), meshed with structured flat quads
-(MITC4 bending + QM6 membrane + drilling, :mod:`femmech.elements.shell`) by
+(MITC4 bending + QM6 membrane + drilling, :mod:`femmech.fe.elements.shell`) by
 :func:`box_girder` below, ``n`` quads per 0.2 m, and clamped at both ends (all DOFs of
 the two end rings fixed). Sizes: ``10 n (10 n + 1)`` nodes, 6 DOFs each: n = 4, 13, 41
 give 9 840, 102 180 and 1 011 060 DOFs. For each model the benchmark prints
@@ -40,8 +40,8 @@ from pathlib import Path
 import numpy as np
 
 import femmech as fm
-import femmech.linalg
-import femmech.model
+import femmech.fe.model
+import femmech.solve.eigen
 
 HERE = Path(__file__).resolve().parent
 N_MODES = 20
@@ -67,7 +67,7 @@ fmb = _frame_helpers()
 
 def _shell_caller():
     """The module whose ``shell_matrices`` ``build_model`` calls (model.py or parts.py)."""
-    for name in ("femmech.parts", "femmech.model"):
+    for name in ("femmech.fe.parts", "femmech.fe.model"):
         try:
             module = importlib.import_module(name)
         except ImportError:
@@ -117,7 +117,7 @@ def build(mesh):
     timer = fmb.PhaseTimer()
     row = {}
     targets = [(_shell_caller(), "shell_matrices", "element"),
-               (femmech.model, "assemble", "coo_csr")]
+               (femmech.fe.model, "assemble", "coo_csr")]
     with fmb.peak_memory(row, "build_peak_mb"), timer.patched(targets):
         start = time.perf_counter()
         model = fm.build_model(mesh, shells={"walls": fm.ShellProperty(THICKNESS, STEEL)},

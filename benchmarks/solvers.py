@@ -3,7 +3,7 @@
 For each model (grid space frames of ~20k and ~150k DOFs, optionally the 59k-DOF shell
 machine bed of scale.py and a hexahedral solid block of ~35k DOFs, where the factors are
 much denser) and each backend of
-:mod:`femmech.solvers` (SuperLU always; CHOLMOD and MKL PARDISO when installed):
+:mod:`femmech.solve.direct` (SuperLU always; CHOLMOD and MKL PARDISO when installed):
 
 - *unit*: the cost model of a 20-mode shift-invert solve, measured on its own: symbolic
   analysis + numeric factorisation of ``K - σM`` + 55 single-vector solves (one thread
@@ -21,7 +21,7 @@ much denser) and each backend of
 - *agreement*: the largest relative difference of the frequencies from the first
   backend's (SuperLU).
 
-Thread settings (:func:`femmech.threads.describe`), library versions and the machine are
+Thread settings (:func:`femmech.solve.threads.describe`), library versions and the machine are
 printed with the tables.
 
 Usage::
@@ -43,9 +43,10 @@ from pathlib import Path
 import numpy as np
 
 import femmech as fm
-import femmech.linalg
-from femmech import sections, solvers, threads
-from femmech.generators import grid_frame
+import femmech.solve.eigen
+from femmech.fe import sections
+from femmech.fe.generators import grid_frame
+from femmech.solve import direct, threads
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from frame_modes import (  # noqa: E402  (sibling benchmark: shared measurement helpers)
@@ -110,7 +111,7 @@ def solid_block(nx, ny, nz):
 def unit_cost(model, name, sigma):
     """(analyse s, factorise s, seconds of N_SOLVES single-vector solves)."""
     A = (model.K_free - sigma * model.M_free).tocsc()
-    factor = solvers.factorize(A, name, definite=True)
+    factor = direct.factorize(A, name, definite=True)
     b = np.random.default_rng(7).standard_normal(A.shape[0])
     with threads.solve_phase():
         start = time.perf_counter()
@@ -142,18 +143,18 @@ def eigen_solve(model, name, check=True):
     timer = PhaseTimer()
     row = {}
     counter = [0, 0]  # solve calls, vectors solved
-    original = femmech.linalg.factorize
-    targets = [(femmech.linalg, "inertia_below", "sturm"),
-               (femmech.linalg, "_lowest_pairs", "arpack")]
-    femmech.linalg.factorize = _counting_factorize(counter, original)
+    original = femmech.solve.eigen.factorize
+    targets = [(femmech.solve.eigen, "inertia_below", "sturm"),
+               (femmech.solve.eigen, "_lowest_pairs", "arpack")]
+    femmech.solve.eigen.factorize = _counting_factorize(counter, original)
     try:
-        with timer.patched(targets + [(femmech.linalg, "factorize", "factor")]), \
+        with timer.patched(targets + [(femmech.solve.eigen, "factorize", "factor")]), \
                 peak_memory(row, "peak_mb"):
             start = time.perf_counter()
             result = fm.modes(model, n_modes=N_MODES, solver=name, check=check)
             row["eigen_s"] = time.perf_counter() - start
     finally:
-        femmech.linalg.factorize = original
+        femmech.solve.eigen.factorize = original
     row.update({f"{k}_s": timer.seconds.get(k, 0.0) for k in ("factor", "arpack", "sturm")})
     row.update(solves=counter[0], vectors_solved=counter[1], omega2=result.omega2,
                n_modes=result.n_modes, sturm_count=result.sturm_count, solver=result.solver,
@@ -166,7 +167,7 @@ def arpack_solve(model, name, sigma):
     with this backend's factor of ``K - σM`` (factorisation included), tol = 0."""
     K, M = model.K_free, model.M_free
     start = time.perf_counter()
-    factor = solvers.factorize((K - sigma * M).tocsc(), name, definite=True)
+    factor = direct.factorize((K - sigma * M).tocsc(), name, definite=True)
     omega2, solves = counted_eigsh(K, M, N_MODES, sigma, factor)
     return time.perf_counter() - start, solves, omega2
 
@@ -174,7 +175,7 @@ def arpack_solve(model, name, sigma):
 def model_rows(case, names):
     model = build(case)
     n = model.n_free
-    sigma = femmech.linalg.default_shift(model.K_free, model.M_free)
+    sigma = femmech.solve.eigen.default_shift(model.K_free, model.M_free)
     rows = []
     for name in names:
         analyse, factorise, solve_s = unit_cost(model, name, sigma)
@@ -231,11 +232,11 @@ def format_tables(rows) -> list[str]:
 
 
 def header() -> list[str]:
-    versions = solvers.versions()
+    versions = direct.versions()
     return machine_info() + [threads.describe(),
                              "solvers: " + "; ".join(f"{k}: {v}" for k, v in versions.items()),
-                             f"auto picks: {solvers.resolve('auto', 10**6)} (SuperLU below"
-                             f" {solvers.AUTO_MIN_SIZE} unknowns)"]
+                             f"auto picks: {direct.resolve('auto', 10**6)} (SuperLU below"
+                             f" {direct.AUTO_MIN_SIZE} unknowns)"]
 
 
 def main(sizes=("20k", "150k"), names=None,
@@ -248,12 +249,12 @@ def main(sizes=("20k", "150k"), names=None,
     unknown = [s for s in sizes if s not in MODELS]
     if unknown:
         raise ValueError(f"unknown sizes {unknown}; choose from {list(MODELS)}")
-    names = list(solvers.available()[::-1] if names is None else names)
+    names = list(direct.available()[::-1] if names is None else names)
     if "superlu" in names:  # the reference of the frequency agreement goes first
         names.remove("superlu")
         names.insert(0, "superlu")
     for name in names:
-        solvers.resolve(name)
+        direct.resolve(name)
     rows = []
     for case in sizes:
         rows += model_rows(case, names)
@@ -269,7 +270,7 @@ def _cli(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--sizes", default="20k,150k", help=f"subset of {','.join(MODELS)}")
     parser.add_argument("--solvers", default=None,
-                        help=f"subset of {','.join(solvers.BACKENDS)} (default: installed)")
+                        help=f"subset of {','.join(direct.BACKENDS)} (default: installed)")
     args = parser.parse_args(argv)
     names = None if args.solvers is None else [s.strip() for s in args.solvers.split(",")]
     main(tuple(s.strip() for s in args.sizes.split(",") if s.strip()), names)

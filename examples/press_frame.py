@@ -46,7 +46,6 @@ import numpy as np
 import scipy.linalg as sla
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.forces import attachment_forces, beam_section_forces, drive_forces
 from femmech.analysis.reference import compare_coupled
 from femmech.analysis.response import (
@@ -59,6 +58,7 @@ from femmech.analysis.response import (
 from femmech.analysis.stability import speed_study
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
+from femmech.fe import sections
 from femmech.mechanisms import (
     SliderCrank,
     plot_quasi_frequencies,

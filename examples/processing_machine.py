@@ -48,7 +48,6 @@ from pathlib import Path
 import numpy as np
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.forces import attachment_forces, drive_forces, support_reactions
 from femmech.analysis.reference import compare_coupled
 from femmech.analysis.response import (
@@ -61,7 +60,8 @@ from femmech.analysis.response import (
 from femmech.analysis.stability import speed_study
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
-from femmech.generators import grid_frame
+from femmech.fe import sections
+from femmech.fe.generators import grid_frame
 from femmech.mechanisms import (
     plot_quasi_frequencies,
     processing_machine,

@@ -36,8 +36,8 @@ from pathlib import Path
 import numpy as np
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.modes import rigid_body_frequencies
+from femmech.fe import sections
 from femmech.output import export_modes_vtu, frequency_table, plot_modes, write_frequency_csv
 
 MESH = Path(__file__).resolve().parent.parent / "meshes" / "welded_box_frame.msh"

@@ -31,7 +31,6 @@ import numpy as np
 import sympy
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.forces import attachment_forces, drive_forces, support_reactions
 from femmech.analysis.reference import compare_coupled
 from femmech.analysis.response import (
@@ -44,6 +43,7 @@ from femmech.analysis.response import (
 from femmech.analysis.stability import speed_study
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
+from femmech.fe import sections
 from femmech.mechanisms import (
     CamProfile,
     CamSegment,

@@ -5,7 +5,6 @@ Importing femmech has no side effects and does not import pyvista (see
 """
 
 from femmech.analysis.modes import ModeSet, modes
-from femmech.constraints import InterpolatingLink, RigidLink, Support
 from femmech.errors import (
     CacheWarning,
     ConvergenceWarning,
@@ -17,11 +16,13 @@ from femmech.errors import (
     SceneError,
     UserCodeError,
 )
-from femmech.io import read_mesh
-from femmech.lumped import PointMass, Spring
-from femmech.materials import Material
-from femmech.mesh import Mesh
-from femmech.model import (
+from femmech.fe import generators, sections
+from femmech.fe.constraints import InterpolatingLink, RigidLink, Support
+from femmech.fe.lumped import PointMass, Spring
+from femmech.fe.materials import Material
+from femmech.fe.mesh import Mesh
+from femmech.fe.mesh_io import read_mesh
+from femmech.fe.model import (
     BeamProperty,
     FEModel,
     ShellProperty,
@@ -30,11 +31,13 @@ from femmech.model import (
     SolidSet,
     build_model,
 )
-from femmech.sections import BeamSection
-
-__version__ = "0.1.0"
+from femmech.fe.sections import BeamSection
+from femmech.version import __version__
 
 __all__ = [
+    "__version__",
+    "generators",
+    "sections",
     "BeamProperty",
     "BeamSection",
     "CacheWarning",

@@ -17,7 +17,7 @@ Exit codes (:data:`EXIT_CODES`):
 ====  ===================================================================================
 
 Errors are one line on stderr, no traceback unless ``--debug``. Suspicious inputs
-(nearly coincident nodes, loose parts, unit mix-ups: :mod:`femmech.checks`) are reported,
+(nearly coincident nodes, loose parts, unit mix-ups: :mod:`femmech.fe.checks`) are reported,
 not refused: one ``warning:`` line each on stdout and in the run's log.
 
 Scene files are data: ``run`` executes Python code a scene names (``module =``) only with
@@ -88,14 +88,13 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _version() -> str:
-    from femmech import __version__
-
+    from femmech.version import __version__
     return __version__
 
 
 def _check(args) -> int:
-    from femmech.scene import load_scene
-    from femmech.scene_build import finding_lines, prepare
+    from femmech.scene.build import finding_lines, prepare
+    from femmech.scene.load import load_scene
 
     path = args.scene
     prepared = prepare(load_scene(path), code_root=args.code_root, run_code=False)
@@ -116,8 +115,8 @@ def _check(args) -> int:
 
 
 def _run(args) -> int:
-    from femmech.cache import default_cache_dir
-    from femmech.scene_run import run_scene
+    from femmech.scene.cache import default_cache_dir
+    from femmech.scene.run import run_scene
 
     cache = None if args.no_cache else (args.cache_dir or default_cache_dir())
     bars = not args.quiet and sys.stderr.isatty()
@@ -148,7 +147,7 @@ def _logging_to_stdout(level: int):
 
 
 def _cache(args) -> int:
-    from femmech.cache import cache_info, clear_cache, default_cache_dir, format_cache_info
+    from femmech.scene.cache import cache_info, clear_cache, default_cache_dir, format_cache_info
 
     folder = args.cache_dir or default_cache_dir()
     if args.action == "clear":

@@ -1,9 +1,9 @@
 """Frame-mechanism coupling: rheolinear mechanisms mounted on frames.
 
 A coupled machine has global coordinates ``x = [u; q_own]``: the frame coordinates u
-(reduced coordinates of a :class:`~femmech.reduction.Superelement`, global coordinates
-of an :class:`~femmech.substructures.Assembly`, or free DOFs of an unreduced
-:class:`~femmech.model.FEModel`) followed by the mechanisms' own vibration coordinates.
+(reduced coordinates of a :class:`~femmech.reduction.reduce.Superelement`, global coordinates
+of an :class:`~femmech.reduction.substructures.Assembly`, or free DOFs of an unreduced
+:class:`~femmech.fe.model.FEModel`) followed by the mechanisms' own vibration coordinates.
 A mechanism coordinate attached *rigidly* to the frame is the frame motion
 ``q_c = L u`` (DOF compatibility, primal assembly); an *elastic* attachment keeps q_c as
 an own coordinate and adds a bearing spring/damper ``½ k (q_c - L u)²``. ``L`` is a
@@ -29,10 +29,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from femmech.dofs import COMPONENTS, DOF_PER_NODE
-from femmech.model import FEModel, node_index
-from femmech.reduction import Superelement
-from femmech.substructures import Assembly
+from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
+from femmech.fe.model import FEModel, node_index
+from femmech.reduction.reduce import Superelement
+from femmech.reduction.substructures import Assembly
 
 
 @dataclass(frozen=True)

@@ -40,7 +40,7 @@ class NumericalError(RuntimeError):
 class ModelWarning(FemmechWarning):
     """A model input looks wrong (nearly coincident nodes, a free body by accident, a unit
     mix-up): the results are computed but are probably not those of the intended model.
-    See :mod:`femmech.checks`."""
+    See :mod:`femmech.fe.checks`."""
 
 
 class CacheWarning(FemmechWarning):

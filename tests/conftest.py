@@ -5,7 +5,7 @@ SkylakeX, Zen, ...) and between thread counts. Tolerances must hold on any of th
 ``roundoff.py``). To catch a tolerance that only holds for one summation order, ``.ci/run``
 runs the tests again with ``FEMMECH_TEST_BLAS_THREADS=1`` and with ``=2``. The default run
 computes femmech's solve phases and the hard cases on 1 thread and leaves everything else
-on all cores (``femmech.threads``, ``hard_cases/conftest.py``), so each part of the suite
+on all cores (``femmech.solve.threads``, ``hard_cases/conftest.py``), so each part of the suite
 sums in another order in one of the two extra runs. OpenBLAS only splits large
 operations between threads, so this catches part of what another kernel changes (in probe
 runs, 44 % of the assertions whose values a Haswell kernel changed); the tolerances
@@ -16,7 +16,7 @@ themselves must follow from the problem.
 * every loaded BLAS and OpenMP library is limited to N threads (threadpoolctl), and
   ``OPENBLAS_NUM_THREADS``, ``MKL_NUM_THREADS`` and ``OMP_NUM_THREADS`` are set to N for
   libraries loaded later (PARDISO's MKL, CHOLMOD's OpenMP) and for subprocesses;
-* femmech's *solve* and *factor* phases use N threads (``femmech.threads.set_threads``);
+* femmech's *solve* and *factor* phases use N threads (``femmech.solve.threads.set_threads``);
 * ``hard_cases/conftest.py`` limits its modules to N threads instead of 1.
 
 The header of the pytest run names the libraries and their thread counts. This file also
@@ -56,8 +56,7 @@ def pytest_configure(config):
         os.environ[var] = str(n)
     import numpy as np
 
-    from femmech import threads
-
+    from femmech.solve import threads
     np.ones((2, 2)) @ np.ones((2, 2))  # load the BLAS
     threads.set_threads(solve=n, factor=n)
     _limits.append(threadpool_limits(limits=n))
@@ -71,8 +70,7 @@ def pytest_unconfigure(config):
 def pytest_report_header(config):
     import numpy as np
 
-    from femmech import threads
-
+    from femmech.solve import threads
     np.ones((2, 2)) @ np.ones((2, 2))  # load the BLAS
     n = session_threads()
     asked = f"{ENV_VAR}={n}" if n is not None else f"{ENV_VAR} not set"

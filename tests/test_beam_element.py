@@ -1,6 +1,6 @@
 """Property tests of the 2-node 3D Timoshenko / Euler-Bernoulli frame element.
 
-Each test builds single elements with :func:`femmech.elements.beam.beam_matrices` in a random
+Each test builds single elements with :func:`femmech.fe.elements.beam.beam_matrices` in a random
 orientation and checks a property that any correct frame element must have: symmetry,
 rigid-body null space, mass totals, unit scaling, invariance under rotation, consistency
 of the closed-form Timoshenko stiffness with the IIE shape functions, and the
@@ -20,8 +20,8 @@ from roundoff import eigenvalue_rtol, largest_eigenvalue
 from scipy.spatial.transform import Rotation
 
 import femmech as fm
-from femmech import sections
-from femmech.elements.beam import (
+from femmech.fe import sections
+from femmech.fe.elements.beam import (
     beam_matrices,
     bending_matrices,
     bending_shape_functions,

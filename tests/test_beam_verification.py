@@ -26,8 +26,8 @@ from numpy.testing import assert_allclose
 from scipy.optimize import brentq
 
 import femmech as fm
-from femmech import sections
-from femmech.linalg import solve_symmetric
+from femmech.fe import sections
+from femmech.solve.eigen import solve_symmetric
 
 EPS = np.finfo(float).eps
 E, NU, RHO = 210e9, 0.3, 7850.0

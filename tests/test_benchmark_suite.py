@@ -73,8 +73,8 @@ def test_rows_describe_the_models_and_agree_where_they_must(suite, tiny):
     assert [(r["case"], r["free_dofs"]) for r in modes] == [("tiny", 432)]
     assert all(r["build_over_eigen"] > 0 for r in modes)
     solver_rows = results["eigensolve"].rows
-    from femmech import solvers
-    assert sorted(r["solver"] for r in solver_rows) == sorted(solvers.available())
+    from femmech.solve import direct
+    assert sorted(r["solver"] for r in solver_rows) == sorted(direct.available())
     # same pencil, every backend: ARPACK to round-off (measured <= 1e-13); 1e-10 margin
     assert all(r["max_freq_diff"] < 1e-10 for r in solver_rows)
     cb = results["craig_bampton"].rows

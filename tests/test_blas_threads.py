@@ -12,7 +12,7 @@ import os
 import numpy as np
 from threadpoolctl import threadpool_info
 
-from femmech import threads
+from femmech.solve import threads
 
 
 def _counts() -> set[int]:

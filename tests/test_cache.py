@@ -18,9 +18,12 @@ import pytest
 from filelock import FileLock
 
 import femmech
-import femmech.cache as cache_module
-from femmech import reduction
-from femmech.cache import (
+import femmech.scene.cache as cache_module
+from femmech.errors import CacheWarning
+from femmech.reduction import reduce as reduction
+from femmech.reduction.reduce import Superelement, guyan
+from femmech.scene.build import reduction_key_data, sha256_key
+from femmech.scene.cache import (
     STALE_AGE,
     cache_info,
     cache_max_bytes,
@@ -33,11 +36,8 @@ from femmech.cache import (
     remove_stale_temporaries,
     write_entry,
 )
-from femmech.errors import CacheWarning
-from femmech.reduction import Superelement, guyan
-from femmech.scene import Scene
-from femmech.scene_build import reduction_key_data, sha256_key
-from femmech.scene_run import run_scene
+from femmech.scene.load import Scene
+from femmech.scene.run import run_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -247,7 +247,7 @@ def test_corrupted_entry_is_detected_and_rebuilt(first_run, tmp_path, how):
 
 @pytest.fixture(scope="module")
 def superelement():
-    from femmech.scene_build import part_mesh, part_model
+    from femmech.scene.build import part_mesh, part_model
 
     scene = _scene()
     part = scene.parts["rail"]

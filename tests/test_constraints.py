@@ -1,6 +1,6 @@
 """Supports and rigid links (exact elimination ``u = T u_free``).
 
-References are independent of :mod:`femmech.constraints`: the rigid-body kinematics
+References are independent of :mod:`femmech.fe.constraints`: the rigid-body kinematics
 ``u_s = u_m + θ_m × r``, ``θ_s = θ_m`` (small rotations) are evaluated here with
 ``np.cross``, and "rigid" is approached by making the linked part of a beam model
 stiffer and stiffer (the difference must fall like 1/stiffness).
@@ -14,7 +14,7 @@ import scipy.linalg as sla
 from numpy.testing import assert_allclose, assert_array_equal
 
 import femmech as fm
-from femmech import sections
+from femmech.fe import sections
 
 EPS = np.finfo(float).eps
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)

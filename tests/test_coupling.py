@@ -7,10 +7,9 @@ import sympy
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.sweep import frequency_sensitivities, frozen_modes, mac_matrix, sweep
 from femmech.coupling import Attachment, Mount, couple
-from femmech.linalg import solve_symmetric
+from femmech.fe import sections
 from femmech.mechanisms import (
     CamProfile,
     CamSegment,
@@ -24,7 +23,8 @@ from femmech.mechanisms import (
     quasi_modes,
     rheolinear,
 )
-from femmech.reduction import craig_bampton
+from femmech.reduction.reduce import craig_bampton
+from femmech.solve.eigen import solve_symmetric
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
 PARAMS = {"J1": 0.05, "m2": 3.0, "c1": 2e4, "c2": 5e5}
@@ -290,8 +290,8 @@ def test_assembly_frame_equals_single_superelement(cam_model):
     # The beam split in two superelements (assembled at the mid node) carries the
     # mechanism at the shared node (part, node) — the same machine as one superelement
     # of the whole beam: equal quasi-frequencies (both exact to ~1e-9 in this band).
-    from femmech.mesh import line_submesh
-    from femmech.substructures import assemble_parts
+    from femmech.fe.mesh import line_submesh
+    from femmech.reduction.substructures import assemble_parts
 
     fe = _beam()
     mesh = fe.mesh
@@ -356,13 +356,12 @@ def test_batched_angle_matrices_equal_per_angle_assembly(cam_model):
 
 @pytest.mark.parametrize("n_modes", [3, 8])
 def test_dense_symmetric_drivers_agree(monkeypatch, n_modes):
-    # femmech.linalg.dense_symmetric solves the shift-inverted pencil for all pairs
+    # femmech.solve.eigen.dense_symmetric solves the shift-inverted pencil for all pairs
     # (sygvd, 8 of 30 wanted) or the wanted ones (sygvx, 3 of 30, the sweep's frozen-angle
     # solves): both give the same lowest pairs to round-off, with a massless coordinate
     # (infinite λ, dropped) and with a rigid-body mode (singular C: its μ = 1/(0 - σ)
     # dominates, and the round-off of the others grows to ~eps·λ/|σ|, here ~1e-11).
-    from femmech import linalg
-
+    from femmech.solve import eigen
     rng = np.random.default_rng(7)
     n = 30
     A, B = rng.standard_normal((n, n)), rng.standard_normal((n, n))
@@ -370,12 +369,12 @@ def test_dense_symmetric_drivers_agree(monkeypatch, n_modes):
     M[-1], M[:, -1] = 0.0, 0.0
     C = A @ A.T + n * np.eye(n)
     free = np.eye(n) - np.full((n, n), 1.0 / n)  # removes the rigid motion (1, ..., 1)
-    assert 3 < linalg.ALL_PAIRS_FRACTION * n < 8
+    assert 3 < eigen.ALL_PAIRS_FRACTION * n < 8
     for stiffness, rtol in ((C, 1e-12), (free @ C @ free, 1e-9)):
-        lam, V = linalg.dense_symmetric(stiffness, M, n_modes)
+        lam, V = eigen.dense_symmetric(stiffness, M, n_modes)
         other = 2.0 if n_modes == 8 else 0.0  # the other driver
-        monkeypatch.setattr(linalg, "ALL_PAIRS_FRACTION", other)
-        lam_ref, V_ref = linalg.dense_symmetric(stiffness, M, n_modes)
+        monkeypatch.setattr(eigen, "ALL_PAIRS_FRACTION", other)
+        lam_ref, V_ref = eigen.dense_symmetric(stiffness, M, n_modes)
         monkeypatch.undo()
         assert lam.size == n_modes
         assert_allclose(lam, lam_ref, rtol=rtol, atol=1e-12 * lam[-1])
@@ -408,15 +407,14 @@ def test_subspace_mac_equals_pseudo_inverse_formula():
 
 
 def test_sweep_threads_follow_femmech_threads(monkeypatch, cam_model):
-    # The per-angle solves run in femmech.threads' solve phase (1 BLAS thread by
+    # The per-angle solves run in femmech.solve.threads' solve phase (1 BLAS thread by
     # default); the former blas_threads argument still works but is deprecated.
     import warnings
 
     from threadpoolctl import threadpool_info
 
     import femmech.analysis.sweep as sweep_module
-    from femmech import threads
-
+    from femmech.solve import threads
     system = couple(craig_bampton(_beam(), "mid", n_modes=6),
                     [Mount(cam_model, (Attachment("y_g", 20, "uy"),))])
     seen, solve = [], sweep_module.frozen_modes

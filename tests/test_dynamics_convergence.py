@@ -43,10 +43,11 @@ from femmech.mechanisms import (
     rheolinear,
 )
 from femmech.output.diagrams import stability_figure
-from femmech.reduction import craig_bampton
-from femmech.scene import Scene, load_scene
-from femmech.scene_build import prepare
-from femmech.scene_run import Workshop, run_scene
+from femmech.reduction.reduce import craig_bampton
+from femmech.scene.build import prepare
+from femmech.scene.load import Scene, load_scene
+from femmech.scene.run import run_scene
+from femmech.scene.workshop import Workshop
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 CAM = CamProfile((CamSegment(np.pi / 2, 0.02, polynomial_345()), CamSegment(np.pi / 2, 0.0),

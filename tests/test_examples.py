@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from femmech import sections
+from femmech.fe import sections
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

@@ -12,13 +12,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import femmech.scene_tasks as tasks
+import femmech.scene.tasks as tasks
 from femmech.cli import FILESYSTEM, INPUT, INTERNAL, NUMERICAL, main
 from femmech.errors import InputError, UserCodeError
 from femmech.output.folder import MANIFEST
-from femmech.scene import load_scene
-from femmech.scene_build import prepare
-from femmech.scene_run import run_scene
+from femmech.scene.build import prepare
+from femmech.scene.load import load_scene
+from femmech.scene.run import run_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -353,7 +353,7 @@ def test_full_disk_exits_5(tmp_path, monkeypatch, capsys):
     def full(*args, **kwargs):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
-    monkeypatch.setattr("femmech.scene_run.write_report", full)
+    monkeypatch.setattr("femmech.scene.run.write_report", full)
     code = main(["run", str(frame_scene(tmp_path)), "--out", str(tmp_path / "o"), "--no-cache"])
     assert code == FILESYSTEM
     assert "No space left on device" in one_line(capsys.readouterr().err)
@@ -367,8 +367,8 @@ def test_mode_image_is_drawn_at_the_requested_angle(tmp_path):
     import tomllib
 
     from femmech.analysis.sweep import sweep
-    from femmech.scene import Scene
-    from femmech.scene_run import Workshop
+    from femmech.scene.load import Scene
+    from femmech.scene.workshop import Workshop
 
     data = tomllib.loads((ROOT / "examples" / "press_frame.toml").read_text())
     data["analyses"] = {"sweep": {"angles": {"start": "0 deg", "stop": "360 deg", "n": 7},

@@ -12,8 +12,8 @@ from numpy.testing import assert_allclose, assert_array_equal
 from scipy.spatial import cKDTree
 
 import femmech as fm
-from femmech import sections
-from femmech.generators import grid_frame, grid_frame_size
+from femmech.fe import sections
+from femmech.fe.generators import grid_frame, grid_frame_size
 
 CASES = [((2, 2, 2), 1), ((2, 1, 3), 3), ((3, 0, 0), 2), ((2, 1, 0), 4), ((1, 1, 1), 1)]
 

@@ -17,8 +17,8 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 import femmech as fm
-from femmech import sections
-from femmech.io import from_meshio
+from femmech.fe import sections
+from femmech.fe.mesh_io import from_meshio
 
 EPS = np.finfo(float).eps
 

@@ -1,7 +1,7 @@
 """Block Lanczos with partial reorthogonalisation, ordering reuse of the Sturm check and
 chunked shell element batches (issue 10, item 1 and 3).
 
-References: dense LAPACK on the same pencil (:func:`femmech.linalg.dense_symmetric`,
+References: dense LAPACK on the same pencil (:func:`femmech.solve.eigen.dense_symmetric`,
 shift-inverted, relative accuracy ~eps for the lowest modes), ARPACK (``_arpack``) and a
 fresh factorisation of each backend. Tolerances name what limits them: eigenvalues of a
 backward-stable solve are exact for a pencil perturbed by ~eps ‖K‖, so they carry an absolute
@@ -21,16 +21,17 @@ from numpy.testing import assert_allclose
 from roundoff import EPS, eigenvalue_atol
 
 import femmech as fm
-import femmech.elements.shell as shell
-import femmech.linalg as linalg
-from femmech import sections, solvers
-from femmech.generators import grid_frame
-from femmech.linalg import dense_symmetric, factorize, solve_symmetric
+import femmech.fe.elements.shell as shell
+import femmech.solve.eigen as linalg
+from femmech.fe import sections
+from femmech.fe.generators import grid_frame
+from femmech.solve import direct
+from femmech.solve.eigen import dense_symmetric, factorize, solve_symmetric
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
 BACKENDS = [pytest.param(name, marks=pytest.mark.skipif(
-    name not in solvers.available(), reason=f"{name} not installed"))
-    for name in solvers.BACKENDS]
+    name not in direct.available(), reason=f"{name} not installed"))
+    for name in direct.BACKENDS]
 
 
 def frame(subdivisions=3):
@@ -130,11 +131,11 @@ def test_deflated_block_lanczos_finds_the_next_modes(pencil):
 @pytest.mark.parametrize("name", BACKENDS)
 def test_factorize_like_equals_a_fresh_factorisation(pencil, name):
     K, M, sigma, ref, _ = pencil
-    shift = solvers.factorize((K - sigma * M).tocsc(), name, definite=True)
+    shift = direct.factorize((K - sigma * M).tocsc(), name, definite=True)
     cut = 0.5 * (ref[9] + ref[10])
     A = (K - cut * M).tocsc()
     like = shift.factorize_like(A, definite=False)
-    fresh = solvers.factorize(A, name, definite=False)
+    fresh = direct.factorize(A, name, definite=False)
     # Sylvester: 10 eigenvalues of the pencil lie below the cut (dense reference)
     assert like.n_negative == fresh.n_negative == 10
     b = np.random.default_rng(3).standard_normal((A.shape[0], 3))
@@ -153,16 +154,16 @@ def test_sturm_check_factorises_on_the_shift_ordering(monkeypatch, name):
     model = frame()
     K, M = model.K_free, model.M_free
     calls = {"factorize": 0, "like": 0}
-    factorize_ = solvers.factorize
+    factorize_ = direct.factorize
 
     def counting_factorize(*args, **kwargs):
         calls["factorize"] += 1
         return factorize_(*args, **kwargs)
 
-    monkeypatch.setattr(solvers, "factorize", counting_factorize)
-    for cls in (solvers.SuperLUFactor, solvers.CholmodFactor, solvers.PardisoFactor):
+    monkeypatch.setattr(direct, "factorize", counting_factorize)
+    for cls in (direct.SuperLUFactor, direct.CholmodFactor, direct.PardisoFactor):
         monkeypatch.setattr(cls, "factorize_like", _counted(cls.factorize_like, calls))
-    with solvers.use(name):
+    with direct.use(name):
         result = solve_symmetric(K, M, n_modes=10)
     assert calls == {"factorize": 1, "like": 1}  # the shift; the count on its ordering
     assert result.sturm_count == result.omega2.size
@@ -175,17 +176,17 @@ def _counted(method, calls):
     return wrapper
 
 
-@pytest.mark.skipif("pardiso" not in solvers.available(), reason="pardiso not installed")
+@pytest.mark.skipif("pardiso" not in direct.available(), reason="pardiso not installed")
 def test_pardiso_blocks_on_a_sparse_factor_are_solved_column_by_column(pencil, monkeypatch):
     K, M, sigma, _, _ = pencil
     A = (K - sigma * M).tocsc()
-    f = solvers.factorize(A, "pardiso", definite=True)
-    assert f.iparm[17] < solvers.PARDISO_LOOP_FILL * f.n  # a beam frame: a sparse factor
+    f = direct.factorize(A, "pardiso", definite=True)
+    assert f.iparm[17] < direct.PARDISO_LOOP_FILL * f.n  # a beam frame: a sparse factor
     rng = np.random.default_rng(5)
     block = rng.standard_normal((K.shape[0], 40))
     looped = np.column_stack([f.solve(block[:, j]) for j in range(40)])
     assert np.array_equal(f.solve(block), looped)  # the same single solves
-    monkeypatch.setattr(solvers, "PARDISO_LOOP_FILL", 0)  # as for a dense (shell) factor
+    monkeypatch.setattr(direct, "PARDISO_LOOP_FILL", 0)  # as for a dense (shell) factor
     x = f.solve(block)  # PARDISO's multi-right-hand-side solve
     assert np.abs(A @ x - block).max() < 1e-9 * np.abs(block).max()  # backward error ~eps cond
 

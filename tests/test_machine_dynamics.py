@@ -31,7 +31,7 @@ from femmech.analysis.stability import (
 from femmech.coupling import Attachment, Mount, couple
 from femmech.mechanisms import CamProfile, CamSegment, harmonic, rheolinear, second_kind
 from femmech.output.diagrams import plot_orbit, plot_time_histories, write_history_csv
-from femmech.reduction import craig_bampton
+from femmech.reduction.reduce import craig_bampton
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

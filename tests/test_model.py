@@ -16,10 +16,10 @@ from numpy.testing import assert_allclose, assert_array_equal
 from scipy.spatial.transform import Rotation
 
 import femmech as fm
-import femmech.model as fm_model
-from femmech import sections
-from femmech.assembly import assemble
-from femmech.elements.beam import beam_matrices
+import femmech.fe.model as fm_model
+from femmech.fe import sections
+from femmech.fe.assembly import assemble
+from femmech.fe.elements.beam import beam_matrices
 
 EPS = np.finfo(float).eps
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)

@@ -17,15 +17,15 @@ import pytest
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech import checks, sections
 from femmech.cli import main
 from femmech.errors import SceneError
-from femmech.generators import members_frame
-from femmech.mesh import merged_node_index
-from femmech.model import model_findings
-from femmech.scene import Scene
-from femmech.scene_build import prepare
-from femmech.scene_run import run_scene
+from femmech.fe import checks, sections
+from femmech.fe.generators import members_frame
+from femmech.fe.mesh import merged_node_index
+from femmech.fe.model import model_findings
+from femmech.scene.build import prepare
+from femmech.scene.load import Scene
+from femmech.scene.run import run_scene
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")
 RHS = sections.rectangular_hollow(0.06, 0.08, 0.004)
@@ -353,8 +353,7 @@ def test_near_nodes_of_a_dense_cluster_stay_cheap():
     # 3 000 coincident node pairs stacked on one point make 4.5 million pairs closer than
     # the tolerance; the check must name the nodes without listing every pair (it took
     # 29 s and gigabytes for a 10-million-pair mesh before)
-    from femmech import checks
-
+    from femmech.fe import checks
     rng = np.random.default_rng(0)
     n = 3000
     cluster = rng.normal(scale=1e-9, size=(n, 3))

@@ -23,7 +23,8 @@ from numpy.testing import assert_allclose
 from PIL import Image
 
 import femmech as fm
-from femmech import sections
+from femmech.fe import sections
+from femmech.fe.recovery import beam_deflection_curves
 from femmech.output import (
     atomic_path,
     export_modes_vtu,
@@ -36,7 +37,6 @@ from femmech.output import (
     write_frequency_csv,
 )
 from femmech.output.plot import RADIUS_RANGE, SCALE_FRACTION
-from femmech.recovery import beam_deflection_curves
 
 IMAGES = Path(__file__).parent / "images"
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
@@ -83,7 +83,7 @@ def _frame_3d():
 
 
 def test_import_femmech_output_does_not_import_pyvista():
-    code = ("import sys, femmech, femmech.output, femmech.recovery;"
+    code = ("import sys, femmech, femmech.output, femmech.fe.recovery;"
             "assert not {'pyvista', 'vtk', 'vtkmodules'} & set(sys.modules)")
     subprocess.run([sys.executable, "-c", code], check=True)
 

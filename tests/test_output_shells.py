@@ -19,7 +19,7 @@ from numpy.testing import assert_allclose
 from PIL import Image
 
 import femmech as fm
-from femmech import sections
+from femmech.fe import sections
 from femmech.output import export_modes_vtu, mode_scale, plot_mode
 from femmech.output.plot import SCALE_FRACTION, surface_mesh
 from femmech.output.surfaces import boundary_faces, cell_blocks, surface_faces, surface_nodes

@@ -1,6 +1,6 @@
 """Substructure reduction (issue 3): Guyan and Craig-Bampton superelements.
 
-References are independent of :mod:`femmech.reduction`: the full model solved directly
+References are independent of :mod:`femmech.reduction.reduce`: the full model solved directly
 (sparse static solve of ``K_free``, dense ``scipy.linalg.eigh`` of ``K_free, M_free`` on
 small grid frames, the shift-invert solver :func:`femmech.modes` on the 1116-DOF shipped
 machine frame), dense ``eigh`` of the fixed-interface pencil ``K_ii, M_ii``, and the
@@ -26,10 +26,11 @@ import scipy.sparse.linalg as spla
 from numpy.testing import assert_allclose, assert_array_equal, assert_array_less
 
 import femmech as fm
-from femmech import reduction, sections
 from femmech.errors import FileFormatError
-from femmech.generators import grid_frame
-from femmech.reduction import Superelement, craig_bampton, frequency_error_estimates, guyan
+from femmech.fe import sections
+from femmech.fe.generators import grid_frame
+from femmech.reduction import reduce as reduction
+from femmech.reduction.reduce import Superelement, craig_bampton, frequency_error_estimates, guyan
 
 EPS = np.finfo(float).eps
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)

@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from femmech.report import Figure, Section, Table, write_report
-from femmech.scene import Scene
-from femmech.scene_run import run_scene
+from femmech.output.report import Figure, Section, Table, write_report
+from femmech.scene.load import Scene
+from femmech.scene.run import run_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 

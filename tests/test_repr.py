@@ -4,8 +4,8 @@ what it is in one line, never its arrays."""
 import numpy as np
 
 import femmech as fm
-from femmech import sections
-from femmech.reduction import craig_bampton
+from femmech.fe import sections
+from femmech.reduction.reduce import craig_bampton
 
 
 def test_reprs_are_one_line_summaries():

@@ -11,10 +11,10 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 import femmech as fm
 from femmech.errors import SceneError
-from femmech.generators import members_frame
-from femmech.scene import Scene, load_scene
-from femmech.scene_build import part_model, prepare
-from femmech.units import ANGLE, INERTIA, PRESSURE, ROT_STIFFNESS, SPEED, quantity
+from femmech.fe.generators import members_frame
+from femmech.scene.build import part_model, prepare
+from femmech.scene.load import Scene, load_scene
+from femmech.scene.units import ANGLE, INERTIA, PRESSURE, ROT_STIFFNESS, SPEED, quantity
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
@@ -503,11 +503,11 @@ def test_member_subdivisions_are_bounded():
 
 
 def test_scene_file_size_and_nesting_are_bounded(tmp_path, monkeypatch):
-    import femmech.scene
+    import femmech.scene.load
 
     path = tmp_path / "big.toml"
     path.write_text(SMALL)
-    monkeypatch.setattr(femmech.scene, "MAX_SCENE_BYTES", 100)
+    monkeypatch.setattr(femmech.scene.load, "MAX_SCENE_BYTES", 100)
     with pytest.raises(SceneError, match=r"^big.toml: file of \d+ bytes; a scene has at most"
                                          r" 100 \(limit MAX_SCENE_BYTES\)$"):
         load_scene(path)

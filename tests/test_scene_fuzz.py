@@ -1,6 +1,6 @@
 """Scene fuzzing (issue 19): any corruption of a scene is valid or one clean line.
 
-The oracle: reading a scene and :func:`femmech.scene_build.prepare` (what ``femmech
+The oracle: reading a scene and :func:`femmech.scene.build.prepare` (what ``femmech
 check`` runs) either succeed or raise an :class:`~femmech.errors.InputError` (a
 SceneError, a UserCodeError, ...) whose message is one line starting with the scene file
 name. Any other exception (OverflowError, IndexError, MemoryError, RecursionError, a
@@ -24,8 +24,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from femmech.errors import InputError
-from femmech.scene import Scene, load_scene
-from femmech.scene_build import prepare
+from femmech.scene.build import prepare
+from femmech.scene.load import Scene, load_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"

@@ -7,7 +7,6 @@ import sympy
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.forces import (
     SECTION_COMPONENTS,
     beam_section_forces,
@@ -15,10 +14,11 @@ from femmech.analysis.forces import (
 )
 from femmech.analysis.response import Response, periodic_steady_state, rayleigh_damping
 from femmech.coupling import Attachment, Mount, couple
-from femmech.dofs import COMPONENTS
+from femmech.fe import sections
+from femmech.fe.dofs import COMPONENTS
 from femmech.mechanisms import Load, Mechanism, PointMass, RotaryInertia, rheolinear
-from femmech.reduction import craig_bampton
-from femmech.substructures import assemble_parts
+from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.substructures import assemble_parts
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
 LENGTH, N_EL = 1.2, 6  # cantilever, m

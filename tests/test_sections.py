@@ -13,7 +13,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech import sections
+from femmech.fe import sections
 
 EPS = np.finfo(float).eps
 RTOL = 10 * EPS  # closed-form expressions: round-off

@@ -1,6 +1,6 @@
 """Element property tests of the flat shell elements (quad MITC4/QM6, triangle MITC3/CST).
 
-Each test builds single elements with :func:`femmech.elements.shell.shell_matrices` and
+Each test builds single elements with :func:`femmech.fe.elements.shell.shell_matrices` and
 checks a property that any correct element has: symmetry, semi-definiteness, exactly
 six rigid-body modes, mass and rotary inertia, dimensional scaling, invariance to the
 global frame and to the node numbering, the membrane patch test; then the integration
@@ -13,8 +13,8 @@ import scipy.linalg as sl
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech.elements.shell import shell_frames, shell_matrices
-from femmech.sections import rectangle
+from femmech.fe.elements.shell import shell_frames, shell_matrices
+from femmech.fe.sections import rectangle
 
 E, NU, RHO, T = 200e9, 0.3, 7800.0, 0.02
 EPS = np.finfo(float).eps

@@ -16,14 +16,14 @@ import sympy
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech.elements.solid import (
+from femmech.fe.elements.solid import (
     REFERENCE_NODES,
     SOLID_TYPES,
     assemble_solid,
     reference_element,
     solid_matrices,
 )
-from femmech.sections import rectangle
+from femmech.fe.sections import rectangle
 
 E, NU, RHO = 200e9, 0.3, 7800.0
 EPS = np.finfo(float).eps

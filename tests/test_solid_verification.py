@@ -15,8 +15,8 @@ import pytest
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech.elements.solid import REFERENCE_NODES
-from femmech.sections import rectangle
+from femmech.fe.elements.solid import REFERENCE_NODES
+from femmech.fe.sections import rectangle
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
 _TET_EDGES = [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)]

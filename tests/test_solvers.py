@@ -23,10 +23,11 @@ from numpy.testing import assert_allclose, assert_array_equal
 from threadpoolctl import threadpool_info, threadpool_limits
 
 import femmech as fm
-from femmech import lobpcg, sections, solvers, threads
-from femmech.generators import grid_frame
-from femmech.linalg import eigenvalue_scale, factorize, inertia_below, solve_symmetric
-from femmech.reduction import craig_bampton
+from femmech.fe import sections
+from femmech.fe.generators import grid_frame
+from femmech.reduction.reduce import craig_bampton
+from femmech.solve import direct, lobpcg, threads
+from femmech.solve.eigen import eigenvalue_scale, factorize, inertia_below, solve_symmetric
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_solid_verification import grid_solid  # noqa: E402
@@ -34,7 +35,7 @@ from test_solid_verification import grid_solid  # noqa: E402
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
 RHS = sections.rectangular_hollow(0.06, 0.08, 0.004)
 FAST = [pytest.param(name, marks=pytest.mark.skipif(
-    name not in solvers.available(), reason=f"{name} not installed")) for name in solvers.BACKENDS]
+    name not in direct.available(), reason=f"{name} not installed")) for name in direct.BACKENDS]
 
 
 def frame_model(bays=(2, 1, 1), subdivisions=3, supported=True):
@@ -55,10 +56,10 @@ def pencil():
 
 
 def test_backends_report_availability_and_superlu_is_always_there():
-    assert "superlu" in solvers.available()
-    assert set(solvers.available()) <= set(solvers.BACKENDS)
-    assert solvers.available()[-1] == "superlu"  # the fallback of "auto" comes last
-    assert solvers.versions()["superlu"].startswith("scipy")
+    assert "superlu" in direct.available()
+    assert set(direct.available()) <= set(direct.BACKENDS)
+    assert direct.available()[-1] == "superlu"  # the fallback of "auto" comes last
+    assert direct.versions()["superlu"].startswith("scipy")
 
 
 @pytest.mark.parametrize("name", FAST)
@@ -68,7 +69,7 @@ def test_solves_agree_with_dense_and_superlu(pencil, name):
     A = (K - sigma * M).tocsc()
     rng = np.random.default_rng(1)
     b, B = rng.standard_normal(A.shape[0]), rng.standard_normal((A.shape[0], 4))
-    f = solvers.factorize(A, name)
+    f = direct.factorize(A, name)
     assert f.name == name
     assert f.n == A.shape[0]
     assert f.definite
@@ -80,7 +81,7 @@ def test_solves_agree_with_dense_and_superlu(pencil, name):
     # cond(A) ~ λ_max/σ ~ 1e7 here: 1e-10 relative is round-off
     assert np.linalg.norm(x - ref[:, 0]) <= 1e-10 * np.linalg.norm(ref[:, 0])
     assert np.linalg.norm(X - ref[:, 1:]) <= 1e-10 * np.linalg.norm(ref[:, 1:])
-    lu = solvers.factorize(A, "superlu")
+    lu = direct.factorize(A, "superlu")
     assert np.linalg.norm(x - lu.solve(b)) <= 1e-10 * np.linalg.norm(x)
 
 
@@ -91,10 +92,10 @@ def test_inertia_counts_eigenvalues_below_the_shift(pencil, name, index):
     # eigenvalues (Sylvester's law of inertia; λ from dense eigvalsh of L⁻¹KL⁻ᵀ)
     K, M, lam = pencil
     cut = 0.5 * (lam[index] + lam[index + 1])
-    f = solvers.factorize((K - cut * M).tocsc(), name, definite=False)
+    f = direct.factorize((K - cut * M).tocsc(), name, definite=False)
     assert f.n_negative == index + 1
     assert not f.definite
-    assert f.n_negative == solvers.factorize((K - cut * M).tocsc(), "superlu").n_negative
+    assert f.n_negative == direct.factorize((K - cut * M).tocsc(), "superlu").n_negative
     # the indefinite factor solves too: backward error ‖Ax - b‖ / (‖A‖ ‖x‖) at round-off
     # (1e-12 leaves room for the growth of pivots of an LDLᵀ without pivoting)
     A = (K - cut * M).tocsc()
@@ -107,22 +108,22 @@ def test_inertia_counts_eigenvalues_below_the_shift(pencil, name, index):
 def test_definite_hint_falls_back_or_refuses(pencil, name):
     K, M, lam = pencil
     A = (K - 0.5 * (lam[2] + lam[3]) * M).tocsc()
-    assert solvers.factorize(A, name, definite=None).n_negative == 3  # tried, fell back
+    assert direct.factorize(A, name, definite=None).n_negative == 3  # tried, fell back
     if name != "superlu":  # SuperLU has one mode for all
         with pytest.raises(ValueError, match="not positive definite"):
-            solvers.factorize(A, name, definite=True)
+            direct.factorize(A, name, definite=True)
 
 
 @pytest.mark.parametrize("name", FAST)
 def test_refactor_reuses_the_analysis(pencil, name):
     K, M, lam = pencil
-    f = solvers.factorize((K + 1.0 * M).tocsc(), name)
+    f = direct.factorize((K + 1.0 * M).tocsc(), name)
     analysed = f.timings["analyse"]
     b = np.arange(K.shape[0], dtype=float)
     for sigma in (-2.0, -0.5 * lam[0]):  # new positive definite values
         A = (K - sigma * M).tocsc()
         assert f.refactor(A) is f
-        fresh = solvers.factorize(A, "superlu").solve(b)
+        fresh = direct.factorize(A, "superlu").solve(b)
         # cond(A) <= λ_max / (0.5 λ_1) ~ 1e7: 1e-10 relative is round-off
         assert np.linalg.norm(f.solve(b) - fresh) <= 1e-10 * np.linalg.norm(fresh)
     if name != "superlu":  # no new symbolic phase (SuperLU has none to keep)
@@ -130,17 +131,17 @@ def test_refactor_reuses_the_analysis(pencil, name):
     # values that are no longer positive definite: the factor switches to LDLᵀ
     A = (K - 0.5 * (lam[4] + lam[5]) * M).tocsc()
     assert f.refactor(A).n_negative == 5
-    fresh = solvers.factorize(A, "superlu").solve(b)
+    fresh = direct.factorize(A, "superlu").solve(b)
     assert np.linalg.norm(f.solve(b) - fresh) <= 1e-9 * np.linalg.norm(fresh)
     with pytest.raises(ValueError, match="order"):
         f.refactor(sp.eye(3, format="csc"))
 
 
 def test_pardiso_refuses_another_pattern(pencil):
-    if "pardiso" not in solvers.available():
+    if "pardiso" not in direct.available():
         pytest.skip("pardiso not installed")
     K, M, _ = pencil
-    f = solvers.factorize((K + M).tocsc(), "pardiso")
+    f = direct.factorize((K + M).tocsc(), "pardiso")
     with pytest.raises(ValueError, match="pattern"):
         f.refactor(sp.eye(K.shape[0], format="csc") + sp.eye(K.shape[0], k=5))
 
@@ -148,14 +149,14 @@ def test_pardiso_refuses_another_pattern(pencil):
 def test_pardiso_thread_settings_may_change_between_calls(pencil):
     # regression: an analysis on 2 threads followed by a factorisation on 1 (the factor
     # phase limited after MKL was loaded) gave wrong solutions, then a segfault
-    if "pardiso" not in solvers.available():
+    if "pardiso" not in direct.available():
         pytest.skip("pardiso not installed")
     K, M, lam = pencil
     A = (K + M).tocsc()
     b = np.ones(K.shape[0])
-    solvers.factorize(A, "pardiso")
+    direct.factorize(A, "pardiso")
     with threads.limit(factor=1):
-        f = solvers.factorize(A, "pardiso")
+        f = direct.factorize(A, "pardiso")
     with threads.limit(factor=2):
         f.refactor((K + 2 * M).tocsc())
     for solve_threads in (1, 2):
@@ -167,16 +168,16 @@ def test_pardiso_thread_settings_may_change_between_calls(pencil):
 
 def test_pardiso_parallel_block_solve_equals_the_column_loop(pencil, monkeypatch):
     # wide blocks on sparse factors are split between copies of the factor solved
-    # concurrently (solvers.PARALLEL_SOLVE_COLUMNS); same ordering and values: the same
+    # concurrently (direct.PARALLEL_SOLVE_COLUMNS); same ordering and values: the same
     # floating-point operations per column, so the results are bitwise equal
-    if "pardiso" not in solvers.available():
+    if "pardiso" not in direct.available():
         pytest.skip("pardiso not installed")
     K, M, _ = pencil
-    f = solvers.factorize((K + M).tocsc(), "pardiso")
-    assert f.iparm[17] < solvers.PARDISO_LOOP_FILL * f.n  # the column loop applies
+    f = direct.factorize((K + M).tocsc(), "pardiso")
+    assert f.iparm[17] < direct.PARDISO_LOOP_FILL * f.n  # the column loop applies
     b = np.random.default_rng(3).standard_normal((K.shape[0], 9))
     serial = f.solve(b)
-    monkeypatch.setattr(solvers, "PARALLEL_SOLVE_COLUMNS", 4)
+    monkeypatch.setattr(direct, "PARALLEL_SOLVE_COLUMNS", 4)
     with threads.limit(factor=3):
         parallel = f.solve(b)
     assert len(f._twins) == 2
@@ -193,7 +194,7 @@ def test_pardiso_parallel_block_solve_equals_the_column_loop(pencil, monkeypatch
 def test_pivots_give_the_determinant_and_bound_the_diagonal(pencil, name):
     K, M, lam = pencil
     A = (K + 1e-3 * lam[0] * M).tocsc()
-    piv, order = solvers.factorize(A, name).pivots()
+    piv, order = direct.factorize(A, name).pivots()
     assert np.array_equal(np.sort(order), np.arange(A.shape[0]))
     # product of the pivots = det A (numpy slogdet: dense LU), 1e-10 relative in log
     sign, logdet = np.linalg.slogdet(A.toarray())
@@ -209,7 +210,7 @@ def test_singular_matrix_is_reported(name):
     # a DOF with neither stiffness nor mass: an exactly zero row and column
     A = sp.diags([2.0, 0.0, 3.0]).tocsc()
     with pytest.raises(ValueError, match="singular|not positive definite"):
-        solvers.factorize(A, name, definite=False if name != "superlu" else None)
+        direct.factorize(A, name, definite=False if name != "superlu" else None)
 
 
 @pytest.mark.parametrize("name", FAST)
@@ -227,37 +228,37 @@ def test_modes_report_the_solver_and_agree_across_backends(name):
 def test_small_models_keep_superlu_and_dense_has_no_solver():
     model = frame_model(bays=(1, 1, 1), subdivisions=2)  # < DENSE_BELOW: LAPACK
     assert fm.modes(model, n_modes=3).solver is None
-    assert solvers.resolve("auto", solvers.AUTO_MIN_SIZE - 1) == "superlu"
-    assert solvers.resolve("auto", solvers.AUTO_MIN_SIZE) == solvers.available()[0]
+    assert direct.resolve("auto", direct.AUTO_MIN_SIZE - 1) == "superlu"
+    assert direct.resolve("auto", direct.AUTO_MIN_SIZE) == direct.available()[0]
 
 
 def test_solver_names_are_checked(monkeypatch):
     with pytest.raises(ValueError, match="unknown solver 'umfpack'"):
-        solvers.resolve("umfpack")
+        direct.resolve("umfpack")
     with pytest.raises(ValueError, match="unknown solver"):
         fm.modes(frame_model(), n_modes=3, solver="umfpack")
-    monkeypatch.setattr(solvers, "available", lambda: ("superlu",))
+    monkeypatch.setattr(direct, "available", lambda: ("superlu",))
     with pytest.raises(ImportError, match="femmech\\[fast\\]"):
-        solvers.resolve("pardiso")
+        direct.resolve("pardiso")
     with pytest.raises(ValueError, match="right-hand side of shape"):
-        solvers.factorize(sp.eye(3, format="csc"), "superlu").solve(np.ones(4))
+        direct.factorize(sp.eye(3, format="csc"), "superlu").solve(np.ones(4))
 
 
 def test_default_solver_from_environment_and_use(monkeypatch):
-    monkeypatch.setenv(solvers.ENV_VAR, "superlu")
-    assert solvers.default_solver() == "superlu"
-    with solvers.use("auto"):
-        assert solvers.default_solver() == "auto"
-        with solvers.use(None):
-            assert solvers.default_solver() == "auto"
-    assert solvers.default_solver() == "superlu"
+    monkeypatch.setenv(direct.ENV_VAR, "superlu")
+    assert direct.default_solver() == "superlu"
+    with direct.use("auto"):
+        assert direct.default_solver() == "auto"
+        with direct.use(None):
+            assert direct.default_solver() == "auto"
+    assert direct.default_solver() == "superlu"
 
 
 def test_linalg_factorize_keeps_superlu_behaviour(pencil):
-    # the SuperLU path of femmech.linalg.factorize is the same call as before the solver
+    # the SuperLU path of femmech.solve.eigen.factorize is the same call as before the solver
     # layer: SuperLU attributes stay reachable and the inertia count is unchanged
     K, M, lam = pencil
-    with solvers.use("superlu"):
+    with direct.use("superlu"):
         lu = factorize((K - 0.5 * (lam[3] + lam[4]) * M).tocsc())
         assert lu.name == "superlu"
         assert np.array_equal(lu.perm_r, lu.perm_c)  # diagonal pivots only
@@ -269,10 +270,10 @@ def test_factor_pickles_as_none(pencil):
     # a factor is a per-process cache: it travels as None (studies send superelements to
     # worker processes), and the receiver factorises again where it needs one
     K, M, _ = pencil
-    f = solvers.factorize((K + M).tocsc(), "superlu")
+    f = direct.factorize((K + M).tocsc(), "superlu")
     assert pickle.loads(pickle.dumps(f)) is None
     se = craig_bampton(frame_model(), "top", n_modes=3)
-    assert isinstance(se.interior_factor, solvers.Factor)
+    assert isinstance(se.interior_factor, direct.Factor)
     copy = pickle.loads(pickle.dumps(se))
     assert copy.interior_factor is None
     np.testing.assert_array_equal(copy.K, se.K)
@@ -383,6 +384,6 @@ def test_lobpcg_arguments_are_checked(solid_block):
 def test_eigen_result_reports_a_user_factor(pencil):
     K, M, _ = pencil
     scale = eigenvalue_scale(K, M)
-    f = solvers.factorize((K + 1e-6 * scale * M).tocsc(), "superlu")
+    f = direct.factorize((K + 1e-6 * scale * M).tocsc(), "superlu")
     result = solve_symmetric(K, M, n_modes=4, sigma=-1e-6 * scale, factor=f)
     assert result.solver == "superlu"

@@ -24,7 +24,6 @@ from scipy.optimize import brentq
 from scipy.special import mathieu_a, mathieu_b
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.stability import (
     StabilityChart,
     coupled_floquet,
@@ -35,6 +34,7 @@ from femmech.analysis.stability import (
 )
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple, drive_breakpoints
+from femmech.fe import sections
 from femmech.mechanisms import (
     CamProfile,
     CamSegment,
@@ -47,7 +47,7 @@ from femmech.mechanisms import (
     position_function,
     rheolinear,
 )
-from femmech.reduction import craig_bampton
+from femmech.reduction.reduce import craig_bampton
 
 # (kind, r, q, value, source)
 PUBLISHED = [

@@ -44,8 +44,8 @@ def cam_on_beam(c2):
     import sympy
 
     import femmech as fm
-    from femmech import sections
     from femmech.coupling import Attachment, Mount, couple
+    from femmech.fe import sections
     from femmech.mechanisms import (
         CamProfile,
         CamSegment,
@@ -57,7 +57,7 @@ def cam_on_beam(c2):
         position_function,
         rheolinear,
     )
-    from femmech.reduction import craig_bampton
+    from femmech.reduction.reduce import craig_bampton
 
     x = np.linspace(0.0, 1.0, 21)
     mesh = fm.Mesh.from_lines(np.column_stack([x, 0 * x, 0 * x]),

@@ -5,13 +5,13 @@ import pytest
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.modes import superelement_modes
-from femmech.generators import grid_frame
-from femmech.linalg import solve_symmetric
-from femmech.mesh import line_submesh
-from femmech.reduction import craig_bampton
-from femmech.substructures import assemble_parts
+from femmech.fe import sections
+from femmech.fe.generators import grid_frame
+from femmech.fe.mesh import line_submesh
+from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.substructures import assemble_parts
+from femmech.solve.eigen import solve_symmetric
 
 PROP = fm.BeamProperty(sections.rectangular_hollow(0.1, 0.1, 0.005),
                        fm.Material(E=210e9, nu=0.3, rho=7850.0))

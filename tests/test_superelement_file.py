@@ -6,7 +6,7 @@ was saved. The corrupted files are built here with the helpers of
 ``benchmarks/fuzz_superelement.py`` (npy members, zip packing, and ``craft``, which
 recomputes the SHA-256 sums as an attacker could, so that the structural checks must
 reject the file). The fuzz run's oracle (:func:`consistency_problems`) is written there
-independently of :mod:`femmech.superelement_file`.
+independently of :mod:`femmech.reduction.superelement_file`.
 """
 
 from __future__ import annotations
@@ -25,8 +25,8 @@ import scipy.sparse as sp
 from numpy.testing import assert_array_equal
 
 from femmech.errors import FileFormatError
-from femmech.reduction import Superelement, guyan
-from femmech.superelement_file import FORMAT_VERSION, PSD_RTOL, SYMMETRY_RTOL
+from femmech.reduction.reduce import Superelement, guyan
+from femmech.reduction.superelement_file import FORMAT_VERSION, PSD_RTOL, SYMMETRY_RTOL
 
 FUZZ_FILE = Path(__file__).resolve().parent.parent / "benchmarks" / "fuzz_superelement.py"
 
@@ -320,7 +320,7 @@ def test_tolerances_separate_round_off_from_damage(tmp_path, base):
 
 
 def test_load_errors_are_value_errors_for_the_cache(tmp_path, base):
-    # femmech.cache treats any ValueError of Superelement.load as a corrupt entry
+    # femmech.scene.cache treats any ValueError of Superelement.load as a corrupt entry
     path = _write(tmp_path, base.data[:100])
     with pytest.raises(ValueError, match="not a readable superelement file"):
         Superelement.load(path)

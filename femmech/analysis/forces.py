@@ -30,10 +30,10 @@ import numpy as np
 
 from femmech.analysis.response import _drive, _node_component, frame_history
 from femmech.coupling import CoupledSystem, frame_row
-from femmech.dofs import COMPONENTS, DOF_PER_NODE
-from femmech.elements.beam import local_matrices
-from femmech.model import FEModel
-from femmech.substructures import Assembly
+from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
+from femmech.fe.elements.beam import local_matrices
+from femmech.fe.model import FEModel
+from femmech.reduction.substructures import Assembly
 
 
 @dataclass(frozen=True)
@@ -327,7 +327,7 @@ def beam_section_forces(system: CoupledSystem, model, response, elements,
     (``dynamic=True``); u_e are the element's 12 local DOFs, recovered from the response
     through only their rows of the recovery
     (:func:`~femmech.analysis.response.frame_history`), and K_e, M_e the element's own
-    matrices (:func:`~femmech.elements.beam.local_matrices`). The force the node exerts on
+    matrices (:func:`~femmech.fe.elements.beam.local_matrices`). The force the node exerts on
     the element is f; the section force (see :class:`SectionForces`) is ``−f_a`` at end a
     and ``+f_b`` at end b.
 
@@ -362,7 +362,7 @@ def beam_section_forces(system: CoupledSystem, model, response, elements,
         Rayleigh coefficients a (1/s) and b (s) of the frame damping of the response, as
         in :func:`~femmech.analysis.response.rayleigh_damping`; with ``dynamic=True`` only.
     part : int, optional
-        For an :class:`~femmech.substructures.Assembly` frame: the part ``model`` is.
+        For an :class:`~femmech.reduction.substructures.Assembly` frame: the part ``model`` is.
 
     Returns
     -------

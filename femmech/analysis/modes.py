@@ -7,11 +7,12 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from femmech import checks, solvers
-from femmech.dofs import DOF_PER_NODE
-from femmech.linalg import RIGID_TOL, default_shift, eigenvalue_scale, solve_symmetric
-from femmech.model import FEModel
-from femmech.reduction import Superelement, frequency_error_estimates
+from femmech.fe import checks
+from femmech.fe.dofs import DOF_PER_NODE
+from femmech.fe.model import FEModel
+from femmech.reduction.reduce import Superelement, frequency_error_estimates
+from femmech.solve import direct
+from femmech.solve.eigen import RIGID_TOL, default_shift, eigenvalue_scale, solve_symmetric
 
 
 @dataclass(frozen=True)
@@ -40,10 +41,10 @@ class ModeSet:
     error_estimate : ndarray (n_modes,) or None
         For modes of a reduced model: a-posteriori estimate of the relative frequency
         error against the unreduced model (see
-        :func:`femmech.reduction.frequency_error_estimates`).
+        :func:`femmech.reduction.reduce.frequency_error_estimates`).
     solver : str or None
         Sparse direct solver of the shift-invert factorisation (``"superlu"``,
-        ``"cholmod"``, ``"pardiso"``; :mod:`femmech.solvers`), ``"pyamg"`` for LOBPCG,
+        ``"cholmod"``, ``"pardiso"``; :mod:`femmech.solve.direct`), ``"pyamg"`` for LOBPCG,
         None for dense LAPACK.
     """
 
@@ -84,7 +85,7 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
     below zero, so a singular K is never factorised, and rigid-body modes come out at
     ~0 Hz flagged in :attr:`ModeSet.rigid`. A repeated n-th eigenvalue returns its whole
     cluster (possibly more than ``n_modes`` modes). Systems below
-    :data:`femmech.linalg.DENSE_BELOW` free DOFs use dense LAPACK.
+    :data:`femmech.solve.eigen.DENSE_BELOW` free DOFs use dense LAPACK.
 
     Parameters
     ----------
@@ -93,19 +94,19 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
         Number of lowest modes.
     band_hz : (float, float), optional
         All modes with ``f_lo <= f <= f_hi``, Hz (exactly one of n_modes and band_hz). A
-        band from 0 holds all rigid-body modes (:data:`femmech.linalg.RIGID_TOL`).
+        band from 0 holds all rigid-body modes (:data:`femmech.solve.eigen.RIGID_TOL`).
     sigma : float, optional
         Shift in rad²/s² (default: ``-1e-6 ×`` the eigenvalue scale, or the band centre).
     check : bool
         Confirm by a Sturm-sequence count that no mode below the last one was missed.
     solver : str, optional
         Sparse direct solver (``"auto"``, ``"superlu"``, ``"cholmod"``, ``"pardiso"``);
-        default :func:`femmech.solvers.default_solver`. Reported in
+        default :func:`femmech.solve.direct.default_solver`. Reported in
         :attr:`ModeSet.solver`.
     method : str
         ``"shift-invert"`` (Lanczos on a factorisation, Sturm-checked; dense LAPACK for
         small models) or ``"lobpcg"`` (AMG-preconditioned LOBPCG without a factorisation,
-        for models too large to factorise: :mod:`femmech.lobpcg`; n_modes only, no
+        for models too large to factorise: :mod:`femmech.solve.lobpcg`; n_modes only, no
         Sturm check).
 
     Returns
@@ -116,7 +117,7 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
     -----
     ModelWarning
         For a first elastic frequency that only a unit mix-up gives
-        (:func:`femmech.checks.frequency_findings`).
+        (:func:`femmech.fe.checks.frequency_findings`).
 
     Examples
     --------
@@ -140,7 +141,7 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
     if method == "lobpcg":
         result = _lobpcg(model, n_modes, band, sigma)
     elif method == "shift-invert":
-        with solvers.use(solver):
+        with direct.use(solver):
             result = solve_symmetric(Kf, Mf, n_modes=n_modes, band=band, sigma=sigma,
                                      check=check, scale=scale)
     else:
@@ -160,7 +161,7 @@ def is_supported(model: FEModel) -> bool:
 
 
 def _lobpcg(model: FEModel, n_modes, band, sigma):
-    from femmech.lobpcg import lobpcg_symmetric, near_nullspace, node_blocksize
+    from femmech.solve.lobpcg import lobpcg_symmetric, near_nullspace, node_blocksize
 
     if band is not None or sigma is not None or n_modes is None:
         raise ValueError("method='lobpcg' computes the n_modes lowest modes: give n_modes,"
@@ -173,7 +174,7 @@ def model_eigenvalue_scale(model: FEModel) -> float:
     """Eigenvalue scale (rad²/s²) of the free system: shift, rigid threshold, residuals.
 
     The smallest, over the DOF components ux ... rz, of the median ratio
-    ``diag K_free / diag M_free`` (:func:`femmech.linalg.eigenvalue_scale` per
+    ``diag K_free / diag M_free`` (:func:`femmech.solve.eigen.eigenvalue_scale` per
     component). One median over all DOFs is ruled by the rotations of thin shells, whose
     inertia ρt³/12 is tiny: at span/thickness 1e4 their ratios are 1e5 times the
     translational ones and 1e13 times the lowest bending eigenvalue, so that the
@@ -279,7 +280,7 @@ def rigid_body_frequencies(model: FEModel) -> np.ndarray:
     """
     import scipy.linalg
 
-    from femmech.constraints import rigid_link_matrix
+    from femmech.fe.constraints import rigid_link_matrix
 
     points = model.mesh.points
     G = rigid_link_matrix(points - points.mean(axis=0)).reshape(-1, 6)

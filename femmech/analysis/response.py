@@ -34,9 +34,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from femmech.coupling import CoupledSystem, assemble_at, frame_row, require_dense_primal
-from femmech.dofs import COMPONENTS, DOF_PER_NODE
 from femmech.errors import ConvergenceWarning
-from femmech.model import node_index
+from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
+from femmech.fe.model import node_index
 
 
 @dataclass(frozen=True)

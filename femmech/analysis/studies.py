@@ -34,9 +34,9 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from femmech import threads
 from femmech.analysis import stability
 from femmech.errors import ConvergenceWarning
+from femmech.solve import threads
 
 
 def default_workers(n_jobs: int | None = None) -> int:

@@ -25,9 +25,9 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
-from femmech import threads
 from femmech.coupling import CoupledSystem
-from femmech.linalg import dense_symmetric
+from femmech.solve import threads
+from femmech.solve.eigen import dense_symmetric
 
 SYMMETRY_RTOL = 1e-10
 """C(φ) counts as symmetric when ``max|C - Cᵀ| <= SYMMETRY_RTOL * max|C|``."""
@@ -47,10 +47,10 @@ UNSTABLE_RTOL = 1e-9
 """A branch is flagged unstable where its damping ratio is below ``-UNSTABLE_RTOL``."""
 
 class _SolvePhase:
-    """Default of the deprecated ``blas_threads``: the limits of :mod:`femmech.threads`."""
+    """Default of the deprecated ``blas_threads``: the limits of :mod:`femmech.solve.threads`."""
 
     def __repr__(self):
-        return "femmech.threads"
+        return "femmech.solve.threads"
 
 
 _SOLVE_PHASE = _SolvePhase()
@@ -227,7 +227,7 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
 
     The mechanism matrices are evaluated for all angles at once
     (:meth:`~femmech.coupling.CoupledSystem.mechanism_blocks`); the per-angle solves run
-    under :func:`femmech.threads.solve_phase` (one BLAS thread by default: many small
+    under :func:`femmech.solve.threads.solve_phase` (one BLAS thread by default: many small
     dense solves run fastest so; on this project's 2-core machine under load, 2 threads
     made a 271-coordinate sweep 25x slower).
 
@@ -253,7 +253,7 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
         Weight of the relative frequency jump against ``1 - MAC`` in the assignment.
     blas_threads : int or None
         Deprecated (DeprecationWarning): set the threads with
-        ``femmech.threads.limit(solve=n)`` or ``FEMMECH_THREADS``. Given, it is the solve
+        ``femmech.solve.threads.limit(solve=n)`` or ``FEMMECH_THREADS``. Given, it is the solve
         limit of this call (``None``: leave the libraries alone).
 
     Returns
@@ -316,14 +316,14 @@ def parameter_sweep(system_at, values, phi: float = 0.0, n_modes: int = 6,
 
 @contextmanager
 def _solve_phase(blas_threads):
-    """:func:`femmech.threads.solve_phase`, with the deprecated ``blas_threads`` (if
+    """:func:`femmech.solve.threads.solve_phase`, with the deprecated ``blas_threads`` (if
     given) as the solve limit."""
     if blas_threads is _SOLVE_PHASE:
         with threads.solve_phase():
             yield
         return
-    warnings.warn("blas_threads is deprecated: the sweeps run under femmech.threads"
-                  " (femmech.threads.limit(solve=n) or FEMMECH_THREADS='solve=n')",
+    warnings.warn("blas_threads is deprecated: the sweeps run under femmech.solve.threads"
+                  " (femmech.solve.threads.limit(solve=n) or FEMMECH_THREADS='solve=n')",
                   DeprecationWarning, stacklevel=4)
     with threads.limit(solve=blas_threads), threads.solve_phase():
         yield

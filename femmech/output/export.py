@@ -18,8 +18,8 @@ import meshio
 import numpy as np
 
 from femmech.analysis.modes import ModeSet
-from femmech.dofs import DOF_PER_NODE
-from femmech.model import FEModel
+from femmech.fe.dofs import DOF_PER_NODE
+from femmech.fe.model import FEModel
 from femmech.output.surfaces import cell_blocks
 
 

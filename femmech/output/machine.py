@@ -16,10 +16,10 @@ import numpy as np
 
 from femmech.analysis.modes import ModeSet
 from femmech.coupling import CoupledSystem, _weights
-from femmech.dofs import DOF_PER_NODE
-from femmech.model import FEModel, node_index
+from femmech.fe.dofs import DOF_PER_NODE
+from femmech.fe.model import FEModel, node_index
 from femmech.output.plot import SCALE_FRACTION, model_size, plot_mode
-from femmech.reduction import Superelement
+from femmech.reduction.reduce import Superelement
 
 MECHANISM_COLOR = "#e07b00"
 OFFSET_FRACTION = 0.06

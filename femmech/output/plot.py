@@ -2,7 +2,7 @@
 
 pyvista is imported inside the functions, so ``import femmech.output`` stays light.
 Beams are drawn as tubes along the deformed curves recovered with the elements' shape
-functions (:func:`femmech.recovery.beam_deflection_curves`), coloured by the
+functions (:func:`femmech.fe.recovery.beam_deflection_curves`), coloured by the
 displacement magnitude, over a grey ghost of the undeformed structure.
 
 Shells are drawn as surfaces at their mid-surface (no thickness) and solids by their
@@ -29,11 +29,11 @@ from pathlib import Path
 import numpy as np
 
 from femmech.analysis.modes import ModeSet
-from femmech.dofs import DOF_PER_NODE
-from femmech.model import FEModel, node_index
+from femmech.fe.dofs import DOF_PER_NODE
+from femmech.fe.model import FEModel, node_index
+from femmech.fe.recovery import beam_deflection_curves
 from femmech.output.export import _check_sizes, _mode_indices, atomic_path
 from femmech.output.surfaces import shell_cells, solid_cells, surface_faces, surface_nodes
-from femmech.recovery import beam_deflection_curves
 
 SCALE_FRACTION = 0.12
 """Automatic scale: the largest drawn displacement is this fraction of the model size."""

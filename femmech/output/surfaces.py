@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from femmech.model import FEModel
+from femmech.fe.model import FEModel
 
 # Faces of the linear solid cells, by corner nodes in meshio / VTK order, ordered
 # counter-clockwise seen from outside for a positively oriented cell.

@@ -10,7 +10,7 @@ from threadpoolctl import threadpool_limits
 def _single_blas_thread():
     """Dense LAPACK on the small and mid-size matrices of these tests runs fastest on one
     thread when the machine is shared (2 threads made the same solves several times
-    slower under load; cf. femmech.linalg.ARPACK_BLAS_THREADS). Module scope: the limit
+    slower under load; cf. femmech.solve.eigen.ARPACK_BLAS_THREADS). Module scope: the limit
     ends with each module and does not leak into the tests that run after this folder.
     ``FEMMECH_TEST_BLAS_THREADS`` (checked in tests/conftest.py) replaces the 1."""
     n = int(os.environ.get("FEMMECH_TEST_BLAS_THREADS", "").strip() or 1)

@@ -10,7 +10,7 @@ import numpy as np
 import sympy
 
 import femmech as fm
-from femmech import sections
+from femmech.fe import sections
 from femmech.mechanisms import (
     CamProfile,
     CamSegment,
@@ -41,7 +41,7 @@ def line_mesh(n: int, length: float = 1.0, node_sets=None) -> fm.Mesh:
 def grid_model(bays=(2, 1, 1), size=(1.2, 0.8, 1.0), subdivisions=3, supported=True,
                section=RHS, material=STEEL) -> fm.FEModel:
     """Grid frame of one section, clamped at the base joints unless ``supported`` is False."""
-    from femmech.generators import grid_frame
+    from femmech.fe.generators import grid_frame
 
     mesh = grid_frame(bays, size, subdivisions)
     prop = fm.BeamProperty(section, material)

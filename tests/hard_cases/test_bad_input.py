@@ -19,7 +19,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import femmech as fm
-from femmech import sections
+from femmech.fe import sections
 
 PACKAGE = str(Path(fm.__file__).resolve().parent)
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")
@@ -234,7 +234,7 @@ def test_unknown_group_is_named_with_the_known_ones(name, where):
     elif where == "rigid link":
         call = lambda: build(rigid_links=[fm.RigidLink(4, name)])  # noqa: E731
     else:
-        from femmech.reduction import guyan
+        from femmech.reduction.reduce import guyan
 
         call = lambda: guyan(build(), [name])  # noqa: E731
     raises_clean(call, repr(name))
@@ -351,14 +351,14 @@ MESH = Path(__file__).resolve().parents[2] / "meshes" / "machine_frame.msh"
 
 
 def test_mesh_file_size_and_counts_are_bounded(tmp_path, monkeypatch):
-    import femmech.io
+    import femmech.fe.mesh_io
 
-    monkeypatch.setattr(femmech.io, "MAX_MESH_FILE_BYTES", 1000)
+    monkeypatch.setattr(femmech.fe.mesh_io, "MAX_MESH_FILE_BYTES", 1000)
     with pytest.raises(ValueError, match=r"machine_frame.msh: file of \d+ bytes; at most 1000"
                                          r" \(limit MAX_MESH_FILE_BYTES\)"):
         fm.read_mesh(MESH)
     monkeypatch.undo()
-    monkeypatch.setattr(femmech.io, "MAX_NODES", 100)
+    monkeypatch.setattr(femmech.fe.mesh_io, "MAX_NODES", 100)
     with pytest.raises(ValueError, match=r"machine_frame.msh: 188 nodes and \d+ cells; at most"
                                          r" 100 and"):
         fm.read_mesh(MESH)

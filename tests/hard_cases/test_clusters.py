@@ -15,11 +15,11 @@ from hard_models import STEEL, cluster_slices, grid_model, line_mesh, subspace_c
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.modes import superelement_modes
 from femmech.analysis.reference import full_modes
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
+from femmech.fe import sections
 from femmech.mechanisms import (
     CamProfile,
     CamSegment,
@@ -31,7 +31,7 @@ from femmech.mechanisms import (
     position_function,
     rheolinear,
 )
-from femmech.reduction import craig_bampton
+from femmech.reduction.reduce import craig_bampton
 
 SQUARE = sections.rectangular_hollow(0.06, 0.06, 0.004)
 

@@ -12,10 +12,10 @@ from hard_models import STEEL, line_mesh
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.reference import full_modes
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
+from femmech.fe import sections
 from femmech.mechanisms import (
     FourBar,
     Mechanism,
@@ -29,7 +29,7 @@ from femmech.mechanisms import (
     rheolinear,
 )
 from femmech.mechanisms.mounted import slider_crank
-from femmech.reduction import craig_bampton
+from femmech.reduction.reduce import craig_bampton
 
 PRESS = {"J1": 1.5, "m2": 150.0, "c1": 1e6, "c2": 1e9, "b1": 0.0, "b2": 0.0, "F2": 0.0,
          "r": 0.05, "l": 0.35, "e": 0.0}  # kg m², kg, N m/rad, N/m, ..., m

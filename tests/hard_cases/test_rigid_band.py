@@ -20,9 +20,9 @@ from numpy.testing import assert_allclose
 
 import femmech as fm
 from femmech.analysis.modes import model_eigenvalue_scale, superelement_modes
-from femmech.generators import grid_frame
-from femmech.linalg import RIGID_TOL, solve_symmetric
-from femmech.reduction import craig_bampton
+from femmech.fe.generators import grid_frame
+from femmech.reduction.reduce import craig_bampton
+from femmech.solve.eigen import RIGID_TOL, solve_symmetric
 
 
 def plate_model():

@@ -23,14 +23,14 @@ from hard_models import (
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.modes import superelement_modes
 from femmech.analysis.reference import full_modes
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
-from femmech.linalg import inertia_below
+from femmech.fe import sections
 from femmech.mechanisms import rheolinear
-from femmech.reduction import craig_bampton, guyan
+from femmech.reduction.reduce import craig_bampton, guyan
+from femmech.solve.eigen import inertia_below
 
 
 @pytest.mark.parametrize(("subdivisions", "method"), [(3, "dense"), (8, "arpack")])

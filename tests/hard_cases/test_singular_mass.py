@@ -20,11 +20,11 @@ from numpy.testing import assert_allclose, assert_array_less
 from roundoff import eigenvalue_rtol
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.modes import superelement_modes
 from femmech.analysis.reference import full_modes
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
+from femmech.fe import sections
 from femmech.mechanisms import (
     Mechanism,
     PointMass,
@@ -33,7 +33,7 @@ from femmech.mechanisms import (
     position_function,
     rheolinear,
 )
-from femmech.reduction import craig_bampton, guyan
+from femmech.reduction.reduce import craig_bampton, guyan
 
 MASSLESS_STEEL = fm.Material(E=210e9, nu=0.3, rho=0.0, name="massless steel")
 

@@ -11,7 +11,7 @@ tube at the shared node to ~eps times its own size. Measured against the condens
 equivalent: 3.9e-7 (this model), 9e-7 with a 0.1 mm connector, 6e-6 with a 0.1 mm,
 200 mm thick one (bending stiffness 2e20 N/m); with a 1 mm, 200 mm thick connector the
 mount modes' relative residual reached 1.5e-6 and femmech warned (FemmechWarning, the
-residual check of femmech.linalg.solve_symmetric). The remedy is a
+residual check of femmech.solve.eigen.solve_symmetric). The remedy is a
 :class:`~femmech.RigidLink`, which eliminates the slave DOFs exactly (the condensed model
 below).
 """
@@ -24,9 +24,9 @@ from numpy.testing import assert_allclose
 from roundoff import largest_eigenvalue
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.modes import superelement_modes
-from femmech.reduction import craig_bampton
+from femmech.fe import sections
+from femmech.reduction.reduce import craig_bampton
 
 K_BEARING, K_MOUNT, K_MOUNT_ROT = 1e12, 1e3, 1e2  # N/m (N m/rad for bearing rotations)
 LENGTH, GAP = 2.0, 1e-3  # m: tube length, connector length
@@ -107,7 +107,7 @@ def test_full_model_matches_condensed_equivalent(n, method):
     rtol = roundoff_rtol(n)
     assert_allclose(result.freq_hz, expected.freq_hz, rtol=rtol)
     # relative residual of the mount modes ~eps λ_max / λ_min (2 rtol): measured 4.3e-7
-    # (dense), 1.5e-7 (ARPACK). NB femmech.linalg warns (an error in tests) at a fixed 1e-6
+    # (dense), 1.5e-7 (ARPACK). NB femmech.solve.eigen warns (an error in tests) at a fixed 1e-6
     assert result.residual.max() < 2 * rtol
     if method == "arpack":
         assert result.sturm_count == 12

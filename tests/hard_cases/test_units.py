@@ -18,11 +18,11 @@ from numpy.testing import assert_allclose
 from roundoff import EPS, largest_eigenvalue
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.modes import superelement_modes
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
-from femmech.generators import grid_frame
+from femmech.fe import sections
+from femmech.fe.generators import grid_frame
 from femmech.mechanisms import (
     CamProfile,
     CamSegment,
@@ -34,7 +34,7 @@ from femmech.mechanisms import (
     position_function,
     rheolinear,
 )
-from femmech.reduction import craig_bampton
+from femmech.reduction.reduce import craig_bampton
 
 UNITS = {"m-kg-s": (1.0, 1.0), "mm-t-s": (1e3, 1e-3)}  # (length, mass) per SI unit
 

@@ -20,9 +20,9 @@ from hard_models import STEEL, line_mesh
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech import sections
 from femmech.analysis.modes import superelement_modes
-from femmech.reduction import craig_bampton
+from femmech.fe import sections
+from femmech.reduction.reduce import craig_bampton
 
 LENGTH = 10.0
 SHAFT = sections.circle(0.05)

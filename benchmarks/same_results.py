@@ -1,0 +1,131 @@
+"""Check that two revisions of femmech compute the same results, to the bit.
+
+A change that only moves code (issue 23: the package restructure) must not change a
+single number. This script runs every example scene (``examples/*.toml``, through the
+CLI) and every example script (``examples/*.py --out``) once with the working tree and
+once with a git revision (checked out into a temporary worktree, imported through
+``PYTHONPATH``), each in its own process with every library on one thread (so that the
+order of floating-point sums is the same), and compares what they wrote:
+
+* data files (``.csv``, ``.txt``, ``.json``, ``.vtu``, ``.xdmf``, ``.h5``, ``.npz``)
+  byte for byte, except the run manifest ``.femmech-run.json`` (it holds the time of
+  the run);
+* what each script printed, with timing lines dropped (lines matching ``TIMING``).
+
+Images and the HTML report are not compared: the report states run times and versions.
+
+Usage::
+
+    python benchmarks/same_results.py --against 9b9c9e1     # working tree vs a revision
+    python benchmarks/same_results.py --collect DIR          # only write this tree's results
+
+Prints one line per compared file and exits 1 if anything differs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import filecmp
+import os
+import re
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+DATA_SUFFIXES = {".csv", ".txt", ".json", ".vtu", ".xdmf", ".h5", ".npz"}
+SKIP_NAMES = {".femmech-run.json"}
+TIMING = re.compile(r"(\d\s*(s|ms|min)\b|seconds|elapsed|\btime\b)", re.IGNORECASE)
+ONE_THREAD = {"FEMMECH_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
+              "MKL_NUM_THREADS": "1"}
+
+
+def _env(tree: Path, cache: Path) -> dict[str, str]:
+    env = dict(os.environ, **ONE_THREAD)
+    env["PYTHONPATH"] = str(tree)
+    env["FEMMECH_CACHE_DIR"] = str(cache)
+    env["MPLBACKEND"] = "Agg"
+    return env
+
+
+def collect(tree: Path, out: Path) -> None:
+    """Run the examples of ``tree`` with the femmech of ``tree``; write into ``out``."""
+    out.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as cache:
+        env = _env(tree, Path(cache))
+        check = subprocess.run([sys.executable, "-c", "import femmech; print(femmech.__file__)"],
+                               env=env, cwd=tree, capture_output=True, text=True, check=True)
+        if not Path(check.stdout.strip()).is_relative_to(tree):
+            raise SystemExit(f"femmech imported from {check.stdout.strip()}, not from {tree}")
+        for scene in sorted((tree / "examples").glob("*.toml")):
+            _run([sys.executable, "-m", "femmech", "run", str(scene), "--allow-code",
+                  "--out", str(out / f"scene_{scene.stem}"), "-q"], env, tree,
+                 out / f"scene_{scene.stem}.stdout")
+        for script in sorted((tree / "examples").glob("*.py")):
+            _run([sys.executable, str(script), "--out", str(out / f"script_{script.stem}")],
+                 env, tree, out / f"script_{script.stem}.stdout")
+
+
+def _run(command, env, cwd, stdout_file: Path) -> None:
+    result = subprocess.run(command, env=env, cwd=cwd, capture_output=True, text=True)
+    lines = [line for line in result.stdout.splitlines() if not TIMING.search(line)]
+    stdout_file.write_text(f"exit {result.returncode}\n" + "\n".join(lines) + "\n")
+    print(f"  ran {Path(command[1] if command[1] != '-m' else command[4]).name}: "
+          f"exit {result.returncode}", flush=True)
+
+
+def compare(reference: Path, candidate: Path) -> int:
+    """Print one line per data file; return the number of differences."""
+    names = {p.relative_to(reference) for p in reference.rglob("*") if _compared(p)}
+    names |= {p.relative_to(candidate) for p in candidate.rglob("*") if _compared(p)}
+    differences = 0
+    for name in sorted(names):
+        a, b = reference / name, candidate / name
+        if not a.exists() or not b.exists():
+            verdict = "only in " + ("candidate" if b.exists() else "reference")
+        else:
+            verdict = "identical" if filecmp.cmp(a, b, shallow=False) else "DIFFERENT"
+        differences += verdict != "identical"
+        print(f"{verdict:>20}  {name}")
+    return differences
+
+
+def _compared(path: Path) -> bool:
+    return (path.is_file() and path.name not in SKIP_NAMES
+            and (path.suffix in DATA_SUFFIXES or path.suffix == ".stdout"))
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--against", metavar="REV", help="git revision to compare with")
+    parser.add_argument("--collect", metavar="DIR", type=Path,
+                        help="only write this tree's results into DIR")
+    parser.add_argument("--keep", metavar="DIR", type=Path,
+                        help="write both result folders here instead of a temporary folder")
+    args = parser.parse_args(argv)
+    if args.collect:
+        collect(ROOT, args.collect)
+        return 0
+    if not args.against:
+        parser.error("give --against REV or --collect DIR")
+    with tempfile.TemporaryDirectory() as tmp:
+        base = args.keep or Path(tmp)
+        worktree = Path(tmp) / "reference_tree"
+        subprocess.run(["git", "worktree", "add", "--detach", str(worktree), args.against],
+                       cwd=ROOT, check=True, capture_output=True)
+        try:
+            print(f"reference: {args.against}")
+            collect(worktree, base / "reference")
+            print("candidate: working tree")
+            collect(ROOT, base / "candidate")
+        finally:
+            subprocess.run(["git", "worktree", "remove", "--force", str(worktree)], cwd=ROOT,
+                           check=False, capture_output=True)
+        differences = compare(base / "reference", base / "candidate")
+    print(f"{differences} difference(s)")
+    return 1 if differences else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

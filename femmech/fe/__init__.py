@@ -1,0 +1,11 @@
+"""Stage 2, the finite-element model: meshes, sections, materials, elements, assembly.
+
+Data flow: mesh (:mod:`.mesh`, :mod:`.mesh_io`, :mod:`.generators`) → properties
+(:mod:`.sections`, :mod:`.materials`) → element matrices (:mod:`.elements`) → sparse
+global K, M (:mod:`.assembly`, :mod:`.dofs`) → supports, links, point masses and springs
+(:mod:`.constraints`, :mod:`.lumped`) → :class:`~femmech.fe.model.FEModel`
+(:mod:`.model`, :mod:`.parts`), with input checks (:mod:`.checks`) and field recovery
+inside beam elements (:mod:`.recovery`).
+
+Imports only :mod:`femmech.errors`: no solver, reduction or analysis code.
+"""

@@ -1,0 +1,19 @@
+"""Stage 8, scene files: a machine and the analyses wanted, in one TOML file, run end to end.
+
+One direction, no circles: quantities with units (:mod:`.units`) → strict reading of a
+table (:mod:`.reader`) → the tables of parts' meshes (:mod:`.mesh`), mechanisms and
+mounts (:mod:`.machine`) and analyses (:mod:`.analyses`) → the validated
+:class:`~femmech.scene.load.Scene` (:mod:`.load`) → mechanism models (:mod:`.mechanisms`)
+→ meshes, FE models, superelements and mounts with every reference checked
+(:mod:`.build`) → cached reductions (:mod:`.cache`) → lazily built objects of one run
+(:mod:`.workshop`) → the analyses' files and report sections (:mod:`.tasks`) → the run
+into one output folder (:mod:`.run`).
+
+Sits on top: may import every lower stage, nothing imports it but :mod:`femmech.cli`.
+"""
+
+from femmech.scene.build import Prepared, part_model, prepare
+from femmech.scene.load import Scene, load_scene
+from femmech.scene.run import RunResult, run_scene
+
+__all__ = ["Prepared", "RunResult", "Scene", "load_scene", "part_model", "prepare", "run_scene"]

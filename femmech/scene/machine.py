@@ -1,0 +1,280 @@
+"""Scene tables ``[mechanisms.<name>]`` and ``[[mounts]]``: mechanism models and attachments.
+
+A mechanism is a built-in model of :mod:`femmech.mechanisms` (:data:`BUILTIN_MODELS`) or a
+function in a user Python module (``module = "my_mech.py"``, ``function = "build"``)
+returning a symbolic :class:`~femmech.mechanisms.Mechanism` (or a ready
+``RheolinearModel``), with parameter values (SI or unit strings) and position functions
+(cams, linkages). A mount places a mechanism on a part: :class:`femmech.coupling.Mount`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from femmech.fe.dofs import COMPONENTS
+from femmech.scene.reader import Reader, show
+from femmech.scene.units import (
+    ANGLE,
+    DAMPING,
+    DIMENSIONLESS,
+    FORCE,
+    INERTIA,
+    LENGTH,
+    MASS,
+    MOMENT,
+    ROT_DAMPING,
+    ROT_STIFFNESS,
+    STIFFNESS,
+)
+
+BUILTIN_MODELS = ("cam_follower", "slider_crank", "table_5_1_case", "processing_machine")
+"""Built-in mechanism models: :func:`femmech.mechanisms.cam_follower`, ``slider_crank``,
+``table_5_1_case`` and ``processing_machine``; ``options`` are their keyword arguments."""
+
+_ROLE_KINDS = {
+    "cam_follower": {"m": ("m", MASS), "c": ("c", STIFFNESS), "c_return": ("c_r", STIFFNESS),
+                     "b": ("b", DAMPING), "F": ("F", FORCE), "J": (None, INERTIA)},
+    "slider_crank": {"m": ("m2", MASS), "c": ("c2", STIFFNESS), "J": ("J1", INERTIA),
+                     "c_t": ("c1", ROT_STIFFNESS), "b": ("b2", DAMPING),
+                     "b_t": ("b1", ROT_DAMPING), "F": ("F2", FORCE)},
+}
+"""Per factory: option (parameter role) → (default parameter name, its dimension)."""
+
+_NAMED_KINDS = {
+    "slider_crank": {"r": LENGTH, "l": LENGTH, "e": LENGTH},
+    "table_5_1_case": {"J1": INERTIA, "c1": ROT_STIFFNESS, "b1": ROT_DAMPING, "m2": MASS,
+                       "m3": MASS, "c2": STIFFNESS, "c3": STIFFNESS, "b2": DAMPING,
+                       "b3": DAMPING, "F2": FORCE, "F3": FORCE},
+    "processing_machine": {"J0": INERTIA, "J1": INERTIA, "J2": INERTIA, "m1": MASS, "m2": MASS,
+                           "cT1": ROT_STIFFNESS, "cT2": ROT_STIFFNESS, "c3": STIFFNESS,
+                           "c4": STIFFNESS, "c6": STIFFNESS, "c7": STIFFNESS,
+                           "bT1": ROT_DAMPING, "bT2": ROT_DAMPING, "b3": DAMPING, "b4": DAMPING,
+                           "F1": FORCE, "F2": FORCE, "M0": MOMENT},
+}
+"""Dimensions of parameters with fixed names (others accept any unit, converted to SI)."""
+
+POSITION_KINDS = ("cam", "slider_crank", "four_bar", "chapter_cam")
+MOTION_LAWS = ("polynomial_345", "cycloidal", "harmonic", "modified_sine", "modified_trapezoid")
+
+
+@dataclass(frozen=True)
+class PositionSpec:
+    """A position function U(φ) by kind (see :data:`POSITION_KINDS`) and parameters (SI)."""
+
+    name: str
+    kind: str
+    params: dict
+    where: str = field(default="", compare=False)
+
+
+@dataclass(frozen=True)
+class MechanismSpec:
+    """A mechanism: built-in ``model`` with ``options``, or ``module`` + ``function``."""
+
+    name: str
+    model: str | None
+    module: str | None
+    function: str | None
+    options: dict
+    parameters: dict
+    position_functions: tuple
+    where: str = field(default="", compare=False)
+
+
+@dataclass(frozen=True)
+class AttachmentSpec:
+    """:class:`femmech.coupling.Attachment` with the node as a group name or index."""
+
+    coordinate: str
+    node: object
+    direction: object
+    stiffness: float | None = None
+    damping: float = 0.0
+    where: str = field(default="", compare=False)
+
+
+@dataclass(frozen=True)
+class MountSpec:
+    """:class:`femmech.coupling.Mount` of a named mechanism on a named part."""
+
+    name: str
+    mechanism: str
+    part: str
+    attachments: tuple
+    ratio: float = 1.0
+    phase: float = 0.0
+    where: str = field(default="", compare=False)
+
+
+def parameter_kinds(spec: MechanismSpec) -> dict:
+    """Parameter name → expected dimension for a built-in model (empty for user modules)."""
+    kinds = dict(_NAMED_KINDS.get(spec.model, {}))
+    for role, (default, kind) in _ROLE_KINDS.get(spec.model, {}).items():
+        name = spec.options.get(role, default)
+        if isinstance(name, str):
+            kinds[name] = kind
+    return kinds
+
+
+def read_mechanisms(root: Reader, base: Path) -> dict:
+    """All ``[mechanisms.<name>]`` tables → {name: MechanismSpec}."""
+    out = {}
+    for name, r in root.named_tables("mechanisms").items():
+        r.expect("model", "module", "function", "options", "parameters", "position_functions")
+        if r.has("model") == r.has("module"):
+            raise r.error(None, "give exactly one of model (built-in: one of"
+                                f" {list(BUILTIN_MODELS)}) and module (a Python file)")
+        model = r.string("model", None, choices=BUILTIN_MODELS)
+        module = function = None
+        if model is None:
+            module = base / r.string("module")
+            if not module.is_file():
+                raise r.error("module", f"file not found: {module}")
+            module, function = str(module), r.string("function")
+        options = _options(r, model)
+        spec = MechanismSpec(name, model, module, function, dict(options), {}, (), r.where)
+        kinds = parameter_kinds(spec)
+        p = r.table("parameters", {})
+        params = {key: p.number(key, kinds.get(key)) for key in p.data}
+        funcs = tuple(_position(n, t) for n, t in r.named_tables("position_functions").items())
+        out[name] = MechanismSpec(name, model, module, function, dict(options), params, funcs,
+                                  r.where)
+    return out
+
+
+def _options(r: Reader, model: str | None) -> dict:
+    """The ``options`` table: keyword arguments of the factory (names checked for the
+    built-in models, with a "did you mean")."""
+    options = r.get("options", {})
+    if isinstance(options, dict) and model is not None:
+        import inspect
+
+        from femmech import mechanisms
+        signature = inspect.signature(getattr(mechanisms, model))
+        r.child("options", options).expect(*signature.parameters)
+    if not isinstance(options, dict) or not all(
+            isinstance(v, (str, int, bool)) for v in options.values()):
+        raise r.error("options", f"expected a table of strings, integers or booleans, got"
+                                 f" {show(options)}")
+    return options
+
+
+_POSITION_KEYS = {"cam": ("kind", "segments", "phi_start", "base"),
+                  "slider_crank": ("kind", "r", "l", "e"),
+                  "four_bar": ("kind", "a", "b", "c", "d", "branch", "output"),
+                  "chapter_cam": ("kind", "name")}
+
+
+def _position(name: str, r: Reader) -> PositionSpec:
+    r.expect(*dict.fromkeys(k for keys in _POSITION_KEYS.values() for k in keys))
+    kind = r.string("kind", choices=POSITION_KINDS)
+    r.expect(*_POSITION_KEYS[kind], context=f"for kind = {kind!r}")
+    if kind == "cam":
+        segments = []
+        for s in r.tables("segments"):
+            s.expect("beta", "lift", "law")
+            law = s.string("law", None, choices=MOTION_LAWS)
+            lift = _lift(s)
+            if lift != 0 and law is None:
+                raise s.error("law", f"missing (required for a lift): one of {list(MOTION_LAWS)}")
+            segments.append((s.number("beta", ANGLE, positive=True), lift, law))
+        if not segments:
+            raise r.error("segments", "missing (required): [[...segments]] with beta, lift, law")
+        # the checks of femmech.mechanisms.CamProfile, here so that `check` makes them
+        # for cams of user-code mechanisms too (which it does not build)
+        total = sum(beta for beta, _, _ in segments)
+        if abs(total - 2 * math.pi) > 1e-9:
+            raise r.error("segments", f"the angles beta sum to {total:.12g} rad"
+                                      f" ({math.degrees(total):.9g} deg), not one revolution")
+        lifts = [lift for _, lift, _ in segments]
+        if abs(sum(lifts)) > 1e-12 * max(1.0, max(abs(h) for h in lifts)):
+            raise r.error("segments", f"the lifts sum to {sum(lifts):.6g}, not 0 (the cam"
+                                      " would not return to its start after one revolution)")
+        params = {"segments": tuple(segments), "phi_start": r.number("phi_start", ANGLE, 0.0),
+                  "base": r.number("base", LENGTH, 0.0)}
+    elif kind == "slider_crank":
+        params = {k: r.number(k, LENGTH, 0.0 if k == "e" else None) for k in ("r", "l", "e")}
+        if params["r"] is None or params["l"] is None:
+            raise r.error("r" if params["r"] is None else "l", "missing (required)")
+        if not params["r"] > 0:
+            raise r.error("r", f"expected a positive crank radius, got {params['r']:g} m")
+        if not params["l"] > params["r"] + abs(params["e"]):
+            raise r.error("l", f"expected a coupler longer than r + |e| ="
+                               f" {params['r'] + abs(params['e']):g} m (a fully rotating"
+                               f" crank), got {params['l']:g} m")
+    elif kind == "four_bar":
+        params = {k: r.number(k, LENGTH, positive=True) for k in "abcd"}
+        params["branch"] = r.integer("branch", 1, minimum=-1, maximum=1)
+        if params["branch"] == 0:
+            raise r.error("branch", "expected +1 or -1, got 0")
+        params["output"] = r.string("output", "rocker", choices=("rocker", "coupler"))
+        a, b, c, d = (params[k] for k in "abcd")
+        if not (abs(b - c) < abs(d - a) and d + a < b + c):
+            raise r.error(None, f"four-bar a={a:g}, b={b:g}, c={c:g}, d={d:g} m: the crank"
+                                " cannot turn fully without a dead centre; need |b - c| <"
+                                " |d - a| and d + a < b + c")
+    else:
+        params = {"name": r.string("name", choices=("U1", "U2"))}
+    return PositionSpec(name, kind, params, r.where)
+
+
+def _lift(s: Reader) -> float:
+    from femmech.errors import SceneError
+
+    value = s.get("lift", 0.0)
+    for kind in (LENGTH, ANGLE):
+        try:
+            return s.convert("lift", value, kind)
+        except SceneError:
+            pass
+    raise s.error("lift", "expected a length (translating follower, e.g. '30 mm') or an angle"
+                          f" (rocker, e.g. '20 deg'), got {value!r}")
+
+
+def read_mounts(root: Reader, parts: dict, mechanisms: dict) -> tuple:
+    """All ``[[mounts]]`` → tuple of MountSpec (names of mechanism and part checked)."""
+    out = []
+    for r in root.tables("mounts"):
+        r.expect("name", "mechanism", "part", "attachments", "ratio", "phase")
+        mech = r.string("mechanism")
+        if mech not in mechanisms:
+            raise r.error("mechanism", f"expected one of the [mechanisms] {sorted(mechanisms)},"
+                                       f" got {mech!r}")
+        default_part = next(iter(parts)) if len(parts) == 1 else None
+        part = r.string("part", default_part)
+        if part not in parts:
+            raise r.error("part", f"expected one of the [parts] {sorted(parts)}, got {part!r}")
+        attachments = []
+        for a in r.tables("attachments"):
+            a.expect("coordinate", "node", "direction", "stiffness", "damping")
+            direction = a.get("direction")
+            if isinstance(direction, list):
+                direction = a.vector("direction", (DIMENSIONLESS,) * 6)
+                if not any(direction):
+                    raise a.error("direction", "expected six weights, not all zero")
+            elif direction not in COMPONENTS:
+                raise a.error("direction", f"expected a component name {list(COMPONENTS)} or"
+                                           f" six weights, got {show(direction)}")
+            rotation = isinstance(direction, str) and direction.startswith("r")
+            stiffness = a.number("stiffness", ROT_STIFFNESS if rotation else STIFFNESS, None,
+                                 positive=True)
+            damping = a.number("damping", ROT_DAMPING if rotation else DAMPING, 0.0,
+                               non_negative=True)
+            coordinate = a.string("coordinate")
+            if coordinate in [att.coordinate for att in attachments]:
+                raise a.error("coordinate", f"coordinate {coordinate!r} is attached twice in"
+                                            " this mount")
+            attachments.append(AttachmentSpec(coordinate, a.node_ref("node"), direction,
+                                              stiffness, damping, a.where))
+        if not attachments:
+            raise r.error("attachments", "missing (required): at least one attachment")
+        out.append(MountSpec(r.string("name", f"{mech}{len(out) + 1}"), mech, part,
+                             tuple(attachments), r.number("ratio", DIMENSIONLESS, 1.0),
+                             r.number("phase", ANGLE, 0.0), r.where))
+    names = [m.name for m in out]
+    for i, name in enumerate(names):
+        if name in names[:i]:
+            raise root.error(f"mounts[{i}].name", f"duplicate mount name {name!r}")
+    return tuple(out)

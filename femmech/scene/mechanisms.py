@@ -1,0 +1,132 @@
+"""Mechanism models of a scene: built-in factories or user modules → RheolinearModel.
+
+A user module (``module = "my_mech.py"``) is Python code: it runs only when the caller
+opts in (``allow_code=True``, ``femmech run --allow-code``), and only from a file inside
+the allowed root (the scene's folder unless the caller names another, ``code_root``).
+See the threat model in docs/robustness.md.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+from pathlib import Path
+
+from femmech.errors import SceneError, UserCodeError
+from femmech.mechanisms import (
+    CamProfile,
+    CamSegment,
+    FourBar,
+    Mechanism,
+    RheolinearModel,
+    SliderCrank,
+    cam_follower,
+    cycloidal,
+    harmonic,
+    modified_sine,
+    modified_trapezoid,
+    polynomial_345,
+    processing_machine,
+    processing_machine_cams,
+    rheolinear,
+    slider_crank,
+    table_5_1_case,
+)
+from femmech.scene.load import fail
+
+FACTORIES = {"cam_follower": cam_follower, "slider_crank": slider_crank,
+             "table_5_1_case": table_5_1_case, "processing_machine": processing_machine}
+LAWS = {"polynomial_345": polynomial_345, "cycloidal": cycloidal, "harmonic": harmonic,
+        "modified_sine": modified_sine, "modified_trapezoid": modified_trapezoid}
+
+
+def mechanism_model(scene, spec, code_root=None) -> RheolinearModel:
+    """The rheolinear model of a :class:`~femmech.scene.machine.MechanismSpec`.
+
+    A user module is imported and its function called: the caller has checked the opt-in
+    (:func:`femmech.scene.build.prepare`); its file must lie under ``code_root`` (default:
+    the scene's folder). An exception or ``sys.exit`` inside user code becomes a
+    :class:`~femmech.errors.UserCodeError` at the mechanism's location.
+    """
+    if spec.model is not None:
+        try:
+            built = FACTORIES[spec.model](**spec.options)
+        except Exception as exc:  # wrong option names or types: at the scene location
+            raise fail(scene, spec.where, "options", f"{type(exc).__name__}: {exc}") from None
+    else:
+        path = confined_module(scene, spec, code_root)
+        try:
+            function = getattr(load_module(path), spec.function, None)
+            if not callable(function):
+                raise code_error(scene, spec, "function", f"{path.name} has no function"
+                                 f" {spec.function!r}")
+            built = function(**spec.options)
+        except SceneError:
+            raise
+        except SystemExit as exc:  # a module that exits must not end femmech with its code
+            raise code_error(scene, spec, "module", f"the user code called"
+                             f" sys.exit({exc.code!r}) in {path.name}") from None
+        except Exception as exc:  # any failure of user code is reported at its location
+            raise code_error(scene, spec, "function", f"the user code raised"
+                             f" {type(exc).__name__}: {exc}") from None
+    if isinstance(built, RheolinearModel):
+        if spec.parameters or spec.position_functions:
+            raise fail(scene, spec.where, "parameters", "the function returned a ready"
+                       " RheolinearModel: give no parameters or position_functions")
+        return built
+    if not isinstance(built, Mechanism):
+        raise fail(scene, spec.where, "function" if spec.module else "model",
+                   f"expected a Mechanism or RheolinearModel, got {type(built).__name__}")
+    funcs = {p.name: position_function(scene, p) for p in spec.position_functions}
+    try:
+        return rheolinear(built, spec.parameters, funcs)
+    except (ValueError, TypeError, KeyError, AttributeError) as exc:
+        raise fail(scene, spec.where, "parameters", str(exc).strip("'\"")) from None
+
+
+def position_function(scene, p):
+    """CamProfile, SliderCrank, FourBar or a chapter cam from a PositionSpec."""
+    try:
+        if p.kind == "cam":
+            segments = tuple(CamSegment(beta, lift, LAWS[law]() if law else None)
+                             for beta, lift, law in p.params["segments"])
+            return CamProfile(segments, p.params["phi_start"], p.params["base"])
+        if p.kind == "slider_crank":
+            return SliderCrank(**p.params)
+        if p.kind == "four_bar":
+            return FourBar(**p.params)
+        return processing_machine_cams()[p.params["name"]]
+    except ValueError as exc:
+        raise fail(scene, p.where, None, str(exc)) from None
+
+
+def code_error(scene, spec, key: str, message: str) -> UserCodeError:
+    """A one-line UserCodeError at ``[mechanisms.<name>] key``."""
+    return fail(scene, spec.where, key, message, UserCodeError)
+
+
+def confined_module(scene, spec, code_root=None) -> Path:
+    """The resolved path of a mechanism's user module, refused (UserCodeError) unless it
+    is a ``.py`` file under ``code_root`` (default: the scene's folder; symbolic links are
+    resolved first, so a link may not lead out either)."""
+    root = Path(code_root if code_root is not None else scene.base_dir).resolve()
+    path = Path(spec.module).resolve()
+    if path.suffix != ".py":
+        raise code_error(scene, spec, "module", f"expected a Python file (.py), got {path.name!r}")
+    if not path.is_relative_to(root):
+        where = "the scene's folder" if code_root is None else "the code root"
+        raise code_error(scene, spec, "module", f"{path} lies outside {where} {root}; femmech"
+                         " runs scene code only from there (name another folder with"
+                         " --code-root / code_root=)")
+    if not path.is_file():
+        raise code_error(scene, spec, "module", f"file not found: {path}")
+    return path
+
+
+def load_module(path):
+    """Import a user Python file under a private module name (one per path)."""
+    name = "femmech_scene_" + hashlib.sha256(str(path).encode()).hexdigest()[:12]
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
