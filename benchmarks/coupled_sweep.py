@@ -46,7 +46,8 @@ def arpack_full(full, phi: float, n_modes: int) -> dict:
     """
     from frame_modes import counted_eigsh  # sibling benchmark (run.py loads it first)
 
-    from femmech.solve.eigen import factorize, solve_symmetric
+    from femmech.solve.eigen import solve_symmetric
+    from femmech.solve.pencil import factorize
 
     M, _, C, _ = full.matrices(phi)
     C = 0.5 * (C + C.T)  # Ω = 0: symmetric up to round-off
@@ -76,7 +77,7 @@ def reduction_variant(model, cams, guides, f_max_hz: float, residual_vectors: bo
     """
     from femmech.analysis.sweep import sweep
     from femmech.coupling import couple
-    from femmech.reduction.reduce import craig_bampton
+    from femmech.reduction.component_modes import craig_bampton
 
     ex = _example()
     start = time.perf_counter()

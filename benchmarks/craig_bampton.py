@@ -39,7 +39,7 @@ import numpy as np
 import scipy.linalg as sla
 
 import femmech as fm
-from femmech.reduction import reduce as reduction
+import femmech.reduction as reduction
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from frame_modes import _table, machine_info, publish  # noqa: E402  (sibling benchmark)

@@ -58,7 +58,7 @@ import numpy as np
 import scipy.linalg as sla
 from threadpoolctl import threadpool_limits
 
-from femmech.reduction import reduce as reduction
+import femmech.reduction as reduction
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from craig_bampton import (  # noqa: E402  (sibling benchmark: models and helpers)

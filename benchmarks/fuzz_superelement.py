@@ -97,7 +97,7 @@ def build_model():
 
 def build_superelement():
     """Craig-Bampton superelement of :func:`build_model` on its top joints."""
-    from femmech.reduction.reduce import craig_bampton
+    from femmech.reduction.component_modes import craig_bampton
 
     return craig_bampton(build_model(), "top", n_modes=4)
 
@@ -173,7 +173,7 @@ def pack(members: dict, compression=zipfile.ZIP_DEFLATED, prefix="") -> bytes:
 
 def craft(members: dict) -> dict:
     """Members with meta's SHA-256 sums recomputed (what an attacker can always do)."""
-    from femmech.reduction.superelement_file import field_digest, meta_digest
+    from femmech.reduction.superelement_format import field_digest, meta_digest
 
     try:
         dtype, _, shape, payload = split_npy(members["meta"])
@@ -668,7 +668,7 @@ def exercise(se):
 
 def judge(task: dict, ref: dict) -> dict:
     from femmech.errors import FileFormatError
-    from femmech.reduction.reduce import Superelement
+    from femmech.reduction.superelement import Superelement
 
     path = task["path"]
     start = time.perf_counter()
@@ -701,7 +701,7 @@ def worker_main(reference: str):
     import resource
 
     resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
-    import femmech.reduction.reduce  # noqa: F401 (imported before the first timed load)
+    import femmech.reduction.superelement  # noqa: F401 (imported before the first timed load)
 
     ref = reference_fields(reference)
     print("ready", flush=True)

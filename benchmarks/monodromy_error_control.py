@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from femmech.analysis.floquet import coupled_monodromy
 from femmech.analysis.response import rayleigh_damping
-from femmech.analysis.stability import coupled_monodromy
 from femmech.errors import ConvergenceWarning
 from femmech.scene.build import prepare
 from femmech.scene.load import load_scene

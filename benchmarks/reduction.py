@@ -50,10 +50,10 @@ import scipy
 import scipy.linalg as sla
 
 import femmech as fm
+import femmech.reduction as reduction
 from femmech.fe import sections
 from femmech.fe.generators import grid_frame
 from femmech.output.export import atomic_path
-from femmech.reduction import reduce as reduction
 
 N_MODES = 20
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")

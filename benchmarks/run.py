@@ -56,6 +56,7 @@ from threadpoolctl import threadpool_limits
 import femmech as fm
 from femmech.output.export import atomic_path
 from femmech.solve import direct, threads
+from femmech.solve.pardiso import mkl_version
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
@@ -124,7 +125,7 @@ def header(name: str, size: str, load_start, blas_threads) -> list[str]:
     mem_gib = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30
     usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else "?"
     loads = [", ".join(f"{x:.1f}" for x in v) for v in (load_start, os.getloadavg())]
-    pardiso = direct.mkl_version() if "pardiso" in direct.available() else None
+    pardiso = mkl_version() if "pardiso" in direct.available() else None
     exudyn = exudyn_hcb.exudyn_version()
     env = ", ".join(f"{k}={os.environ[k]}" for k in (
         "FEMMECH_THREADS", "FEMMECH_SOLVER", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",

@@ -7,10 +7,14 @@ once with a git revision (checked out into a temporary worktree, imported throug
 ``PYTHONPATH``), each in its own process with every library on one thread (so that the
 order of floating-point sums is the same), and compares what they wrote:
 
-* data files (``.csv``, ``.txt``, ``.json``, ``.vtu``, ``.xdmf``, ``.h5``, ``.npz``)
-  byte for byte, except the run manifest ``.femmech-run.json`` (it holds the time of
-  the run);
-* what each script printed, with timing lines dropped (lines matching ``TIMING``).
+* data files (``.csv``, ``.json``, ``.vtu``, ``.xdmf``, ``.h5``, ``.npz``) byte for
+  byte, except the run manifest ``.femmech-run.json`` (it holds the time of the run);
+* text files (``.txt``) and what each script printed, with durations (``12.3 ms``,
+  ``0.5 s``: :data:`DURATION`) and the output folder's path replaced by placeholders;
+* the arrays of :data:`PROBE`: the solver paths the examples do not take (every installed
+  sparse backend, the dense path, bands, free-free, LOBPCG, Craig-Bampton with and
+  without residual vectors, Guyan), through the public API only, so that the same code
+  runs on both revisions.
 
 Images and the HTML report are not compared: the report states run times and versions.
 
@@ -34,11 +38,47 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-DATA_SUFFIXES = {".csv", ".txt", ".json", ".vtu", ".xdmf", ".h5", ".npz"}
+DATA_SUFFIXES = {".csv", ".json", ".vtu", ".xdmf", ".h5", ".npz"}
+TEXT_SUFFIXES = {".txt", ".stdout"}
 SKIP_NAMES = {".femmech-run.json"}
-TIMING = re.compile(r"(\d\s*(s|ms|min)\b|seconds|elapsed|\btime\b)", re.IGNORECASE)
+DURATION = re.compile(r"\d+(\.\d*)?(e[-+]?\d+)?\s*(ms|s|min)\b")
 ONE_THREAD = {"FEMMECH_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
               "MKL_NUM_THREADS": "1"}
+
+
+PROBE = """
+import sys
+import numpy as np
+import femmech as fm
+from femmech import generators, sections
+from femmech.reduction import craig_bampton, guyan
+out = {}
+mesh = generators.grid_frame((3, 2, 2), (3.0, 2.0, 2.0), subdivisions=3)
+steel = fm.Material(E=210e9, nu=0.3, rho=7850.0)
+beam = fm.BeamProperty(sections.rectangular_hollow(0.1, 0.1, 0.005), steel)
+free = fm.build_model(mesh, {name: beam for name in mesh.cell_sets})
+base = np.flatnonzero(mesh.points[:, 2] == 0.0)
+held = fm.build_model(mesh, {name: beam for name in mesh.cell_sets}, supports=[fm.Support(base)])
+for name, A in (("K", held.K), ("M", held.M)):
+    out[name + "_data"], out[name + "_indices"] = A.data, A.indices
+for solver in ("superlu", "cholmod", "pardiso"):
+    try:
+        r = fm.modes(held, n_modes=12, solver=solver)
+    except ImportError:
+        continue
+    out[f"{solver}_omega2"], out[f"{solver}_shapes"] = r.omega2, r.shapes
+out["band"] = fm.modes(held, band_hz=(10.0, 60.0)).omega2
+out["free"] = fm.modes(free, n_modes=10).omega2
+out["lobpcg"] = fm.modes(held, n_modes=6, method="lobpcg").omega2
+top = np.flatnonzero(mesh.points[:, 2] == mesh.points[:, 2].max())[:2]
+for name, se in (("cb", craig_bampton(held, top, n_modes=15)),
+                 ("cb_residual", craig_bampton(held, top, f_max_hz=80.0, residual_vectors=True)),
+                 ("guyan", guyan(held, top))):
+    out[name + "_K"], out[name + "_M"] = se.K, se.M
+np.savez(sys.argv[1], **out)
+"""
+"""Solver paths through the public API (``femmech`` top level and its ``generators`` and
+``sections``, ``femmech.reduction``); written to ``probe.npz`` and compared byte for byte."""
 
 
 def _env(tree: Path, cache: Path) -> dict[str, str]:
@@ -58,6 +98,11 @@ def collect(tree: Path, out: Path) -> None:
                                env=env, cwd=tree, capture_output=True, text=True, check=True)
         if not Path(check.stdout.strip()).is_relative_to(tree):
             raise SystemExit(f"femmech imported from {check.stdout.strip()}, not from {tree}")
+        probe = subprocess.run([sys.executable, "-c", PROBE, str(out / "probe.npz")], env=env,
+                               cwd=tree, capture_output=True, text=True)
+        print(f"  ran probe: exit {probe.returncode}", flush=True)
+        if probe.returncode:
+            (out / "probe.stdout").write_text(probe.stderr)
         for scene in sorted((tree / "examples").glob("*.toml")):
             _run([sys.executable, "-m", "femmech", "run", str(scene), "--allow-code",
                   "--out", str(out / f"scene_{scene.stem}"), "-q"], env, tree,
@@ -69,8 +114,8 @@ def collect(tree: Path, out: Path) -> None:
 
 def _run(command, env, cwd, stdout_file: Path) -> None:
     result = subprocess.run(command, env=env, cwd=cwd, capture_output=True, text=True)
-    lines = [line for line in result.stdout.splitlines() if not TIMING.search(line)]
-    stdout_file.write_text(f"exit {result.returncode}\n" + "\n".join(lines) + "\n")
+    text = result.stdout.replace(str(stdout_file.parent), "<out>")
+    stdout_file.write_text(f"exit {result.returncode}\n{text}")
     print(f"  ran {Path(command[1] if command[1] != '-m' else command[4]).name}: "
           f"exit {result.returncode}", flush=True)
 
@@ -85,15 +130,26 @@ def compare(reference: Path, candidate: Path) -> int:
         if not a.exists() or not b.exists():
             verdict = "only in " + ("candidate" if b.exists() else "reference")
         else:
-            verdict = "identical" if filecmp.cmp(a, b, shallow=False) else "DIFFERENT"
+            verdict = "identical" if _same(a, b) else "DIFFERENT"
         differences += verdict != "identical"
         print(f"{verdict:>20}  {name}")
     return differences
 
 
+def _same(a: Path, b: Path) -> bool:
+    if a.suffix not in TEXT_SUFFIXES:
+        return filecmp.cmp(a, b, shallow=False)
+    return _normalised(a) == _normalised(b)
+
+
+def _normalised(path: Path) -> str:
+    """Text with durations replaced (they differ from run to run)."""
+    return DURATION.sub("<duration>", path.read_text(encoding="utf-8", errors="replace"))
+
+
 def _compared(path: Path) -> bool:
     return (path.is_file() and path.name not in SKIP_NAMES
-            and (path.suffix in DATA_SUFFIXES or path.suffix == ".stdout"))
+            and path.suffix in DATA_SUFFIXES | TEXT_SUFFIXES)
 
 
 def main(argv=None) -> int:

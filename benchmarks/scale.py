@@ -24,8 +24,8 @@ Phases, each timed and with its peak resident memory above the start of the phas
 - mesh: generating the quads, beams and spiders;
 - build: ``build_model`` (element matrices of shells and beams, assembly, ``Tᵀ K T``);
 - reduce: ``craig_bampton`` with 30 fixed-interface modes and residual vectors, split as
-  :attr:`~femmech.reduction.reduce.Superelement.timings` (factorisation of ``K_ii``, constraint
-  modes, fixed-interface modes with their Sturm check, projection);
+  :attr:`~femmech.reduction.superelement.Superelement.timings` (factorisation of
+  ``K_ii``, constraint modes, fixed-interface modes with their Sturm check, projection);
 - couple: mounting the four mechanisms on the superelement;
 - sweep: 360 drive angles, 10 tracked branches with mode shapes;
 - check (optional, ``--check k``): the unreduced coupled system solved at k angles by
@@ -61,7 +61,7 @@ from femmech.fe import sections
 from femmech.mechanisms import processing_machine_cams, processing_machine_parameters
 from femmech.mechanisms.models import rheolinear
 from femmech.mechanisms.mounted import cam_follower
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 from femmech.solve import direct, threads
 
 HERE = Path(__file__).resolve().parent

@@ -44,6 +44,7 @@ import numpy as np
 
 import femmech as fm
 import femmech.solve.eigen
+import femmech.solve.pencil
 from femmech.fe import sections
 from femmech.fe.generators import grid_frame
 from femmech.solve import direct, threads
@@ -175,7 +176,7 @@ def arpack_solve(model, name, sigma):
 def model_rows(case, names):
     model = build(case)
     n = model.n_free
-    sigma = femmech.solve.eigen.default_shift(model.K_free, model.M_free)
+    sigma = femmech.solve.pencil.default_shift(model.K_free, model.M_free)
     rows = []
     for name in names:
         analyse, factorise, solve_s = unit_cost(model, name, sigma)

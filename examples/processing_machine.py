@@ -72,13 +72,9 @@ from femmech.mechanisms import (
     second_kind,
 )
 from femmech.mechanisms.mounted import cam_follower
-from femmech.output.diagrams import (
-    plot_orbit,
-    plot_speed_study,
-    plot_time_histories,
-    write_history_csv,
-    write_sweep_csv,
-)
+from femmech.output.histories import plot_orbit, plot_time_histories, write_history_csv
+from femmech.output.stability_charts import plot_speed_study
+from femmech.output.sweeps import write_sweep_csv
 from femmech.reduction import craig_bampton
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")

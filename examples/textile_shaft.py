@@ -58,16 +58,10 @@ from femmech.mechanisms import (
     rheolinear,
     second_kind,
 )
-from femmech.output.diagrams import (
-    plot_mac,
-    plot_orbit,
-    plot_speed_study,
-    plot_time_histories,
-    write_history_csv,
-    write_sweep_csv,
-    write_sweep_json,
-)
+from femmech.output.histories import plot_orbit, plot_time_histories, write_history_csv
 from femmech.output.machine import plot_coupled_mode
+from femmech.output.stability_charts import plot_speed_study
+from femmech.output.sweeps import plot_mac, write_sweep_csv, write_sweep_json
 from femmech.reduction import craig_bampton
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")

@@ -2,6 +2,9 @@
 
 Importing femmech has no side effects and does not import pyvista (see
 :mod:`femmech.output` for images and files).
+
+Not a stage: it re-exports the public API of the stages (docs/architecture.md);
+nothing inside femmech imports it.
 """
 
 from femmech.analysis.modes import ModeSet, modes

@@ -1,4 +1,7 @@
-"""``python -m femmech`` is the ``femmech`` command (see :mod:`femmech.cli`)."""
+"""``python -m femmech`` is the ``femmech`` command (see :mod:`femmech.cli`).
+
+Stage 9: imports only femmech.cli.
+"""
 
 import sys
 

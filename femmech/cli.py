@@ -23,6 +23,8 @@ not refused: one ``warning:`` line each on stdout and in the run's log.
 Scene files are data: ``run`` executes Python code a scene names (``module =``) only with
 ``--allow-code``, and only from the scene's folder (or ``--code-root``); ``check`` never
 runs it.
+
+Stage 8 (cli): uses scene, errors and version; only :mod:`femmech.__main__` imports it.
 """
 
 from __future__ import annotations
@@ -115,7 +117,7 @@ def _check(args) -> int:
 
 
 def _run(args) -> int:
-    from femmech.scene.cache import default_cache_dir
+    from femmech.scene.cache_folder import default_cache_dir
     from femmech.scene.run import run_scene
 
     cache = None if args.no_cache else (args.cache_dir or default_cache_dir())
@@ -147,7 +149,12 @@ def _logging_to_stdout(level: int):
 
 
 def _cache(args) -> int:
-    from femmech.scene.cache import cache_info, clear_cache, default_cache_dir, format_cache_info
+    from femmech.scene.cache_folder import (
+        cache_info,
+        clear_cache,
+        default_cache_dir,
+        format_cache_info,
+    )
 
     folder = args.cache_dir or default_cache_dir()
     if args.action == "clear":

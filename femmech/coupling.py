@@ -1,7 +1,7 @@
 """Frame-mechanism coupling: rheolinear mechanisms mounted on frames.
 
 A coupled machine has global coordinates ``x = [u; q_own]``: the frame coordinates u
-(reduced coordinates of a :class:`~femmech.reduction.reduce.Superelement`, global coordinates
+(reduced coordinates of a :class:`~femmech.reduction.superelement.Superelement`, global coordinates
 of an :class:`~femmech.reduction.substructures.Assembly`, or free DOFs of an unreduced
 :class:`~femmech.fe.model.FEModel`) followed by the mechanisms' own vibration coordinates.
 A mechanism coordinate attached *rigidly* to the frame is the frame motion
@@ -20,6 +20,8 @@ with φ_m = ratio_m φ + phase_m. The constant frame part is assembled once; per
 the small mechanism blocks are evaluated (vectorised over all angles) and added on the
 few coordinates they touch. Symbols: M mass, B damping, C stiffness, F force (the
 chapter's); the frame's K is C_0.
+
+Stage 4 (coupling): uses reduction, fe and mechanisms (the position protocol); no analysis.
 """
 
 from __future__ import annotations
@@ -31,8 +33,8 @@ import scipy.sparse as sp
 
 from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
 from femmech.fe.model import FEModel, node_index
-from femmech.reduction.reduce import Superelement
 from femmech.reduction.substructures import Assembly
+from femmech.reduction.superelement import Superelement
 
 
 @dataclass(frozen=True)

@@ -5,6 +5,8 @@ a scene's own Python code) derive from :class:`InputError`; a computation that r
 input but failed is a :class:`NumericalError`. Both derive from the builtin classes code
 already catches (``ValueError``, ``RuntimeError``). The command line maps them to its
 documented exit codes (:mod:`femmech.cli`).
+
+Stage 0: imports nothing of femmech; every module may import it.
 """
 
 

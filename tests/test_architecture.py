@@ -13,6 +13,7 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "femmech"
@@ -141,3 +142,83 @@ def test_stage_order():
 def test_cycle_finder(graph, expected):
     """The checker itself finds a circle of three and none in a chain."""
     assert cycles(graph) == expected
+
+
+# --- adding an element type touches only femmech/fe/elements/ plus its registration ---
+
+WEDGE_TETS = np.array([[0, 1, 2, 3], [1, 2, 3, 4], [2, 3, 4, 5]])
+"""A 6-node wedge (meshio order: bottom triangle 0 1 2, top 3 4 5 above them) as three
+linear tetrahedra (the split femmech.fe.checks.cell_measure uses for its volume)."""
+
+
+def _positive_tets(points, cells):
+    """Tetrahedra of each wedge, two nodes swapped where the volume would be negative."""
+    tets = cells[:, WEDGE_TETS].reshape(-1, 4)
+    x = points[tets]
+    volume = np.linalg.det(np.stack([x[:, 1] - x[:, 0], x[:, 2] - x[:, 0], x[:, 3] - x[:, 0]],
+                                    axis=1))
+    tets[volume < 0] = tets[volume < 0][:, [0, 2, 1, 3]]
+    return tets
+
+
+def wedge_matrices(points, cells, kind, E, nu, rho, n_dof):
+    """A toy solid element: the wedge as the sum of its three linear tetrahedra (family
+    "solid" signature of femmech.fe.elements.registry)."""
+    from femmech.fe.elements.solid import assemble_solid
+
+    tets = _positive_tets(points, cells)
+    return assemble_solid(points, tets, "tetra", np.repeat(E, 3), np.repeat(nu, 3),
+                          np.repeat(rho, 3), n_dof)
+
+
+def _wedge_bar(n: int = 4):
+    """A 1 m bar of n cells along x with a right-triangle cross-section of 0.1 m legs,
+    as wedges; and the same bar as the wedges' tetrahedra."""
+    import femmech as fm
+
+    x = np.linspace(0.0, 1.0, n + 1)
+    section = np.array([[0.0, 0.0], [0.1, 0.0], [0.0, 0.1]])
+    points = np.array([[xi, y, z] for xi in x for y, z in section])
+    wedges = np.array([[3 * i, 3 * i + 1, 3 * i + 2, 3 * i + 3, 3 * i + 4, 3 * i + 5]
+                       for i in range(n)])
+    tets = _positive_tets(points, wedges)
+    as_wedges = fm.Mesh(points, {"wedge": wedges}, {"bar": {"wedge": np.arange(n)}})
+    as_tets = fm.Mesh(points, {"tetra": tets}, {"bar": {"tetra": np.arange(len(tets))}})
+    return as_wedges, as_tets
+
+
+def test_toy_element_touches_only_elements(monkeypatch):
+    """A new cell kind computed by a function of this test file, registered once, runs
+    through build_model and fm.modes unchanged: same K, M and frequencies as the same
+    tetrahedra given as tetra cells (the toy element is their sum, so only the order of
+    summation differs: round-off, rtol 1e-12)."""
+    import femmech as fm
+    from femmech.fe.elements import registry
+
+    as_wedges, as_tets = _wedge_bar()
+    steel = fm.SolidProperty(fm.Material(E=210e9, nu=0.3, rho=7850.0))
+    with pytest.raises(ValueError, match="wedge"):  # not registered: a clear error
+        fm.build_model(as_wedges, solids={"bar": steel})
+    monkeypatch.setitem(registry.ELEMENTS, "wedge",
+                        registry.ElementType("wedge", "solid", wedge_matrices))
+    assert "wedge" in registry.kinds("solid")
+    support = [fm.Support(np.flatnonzero(as_wedges.points[:, 0] == 0.0))]
+    toy = fm.build_model(as_wedges, solids={"bar": steel}, supports=support)
+    reference = fm.build_model(as_tets, solids={"bar": steel}, supports=support)
+    for a, b in ((toy.K, reference.K), (toy.M, reference.M)):
+        assert abs(a - b).max() <= 1e-12 * abs(b).max()
+    f_toy = fm.modes(toy, n_modes=4).freq_hz
+    f_ref = fm.modes(reference, n_modes=4).freq_hz
+    np.testing.assert_allclose(f_toy, f_ref, rtol=1e-9)
+
+
+def test_registry_refuses_bad_entries():
+    from femmech.fe.elements import registry
+
+    with pytest.raises(ValueError, match="already has an element"):
+        registry.register(registry.ElementType("quad", "shell", wedge_matrices))
+    with pytest.raises(ValueError, match="unknown cell kind 'prism'"):
+        registry.ElementType("prism", "solid", wedge_matrices)
+    with pytest.raises(ValueError, match="family"):
+        registry.ElementType("wedge", "membrane", wedge_matrices)
+    assert registry.kinds("shell") == ("triangle", "quad")

@@ -18,23 +18,23 @@ import pytest
 from filelock import FileLock
 
 import femmech
+import femmech.reduction as reduction
 import femmech.scene.cache as cache_module
+import femmech.scene.cache_folder as cache_folder
 from femmech.errors import CacheWarning
-from femmech.reduction import reduce as reduction
-from femmech.reduction.reduce import Superelement, guyan
+from femmech.reduction.component_modes import guyan
+from femmech.reduction.superelement import Superelement
 from femmech.scene.build import reduction_key_data, sha256_key
-from femmech.scene.cache import (
+from femmech.scene.cache import cached_reduction, read_entry, write_entry
+from femmech.scene.cache_folder import (
     STALE_AGE,
     cache_info,
     cache_max_bytes,
-    cached_reduction,
     clear_cache,
     entry_paths,
     format_cache_info,
     lock_path,
-    read_entry,
     remove_stale_temporaries,
-    write_entry,
 )
 from femmech.scene.load import Scene
 from femmech.scene.run import run_scene
@@ -339,6 +339,7 @@ def _read_only(monkeypatch) -> None:
         raise PermissionError(errno.EACCES, "Permission denied", str(path))
 
     monkeypatch.setattr(cache_module, "FileLock", _DeniedLock)
+    monkeypatch.setattr(cache_folder, "FileLock", _DeniedLock)
     monkeypatch.setattr(Superelement, "save", denied)
 
 
@@ -581,7 +582,7 @@ def test_size_limit_from_the_environment(monkeypatch, text, expected):
 def test_unreadable_size_limit_warns_and_uses_the_default(monkeypatch):
     monkeypatch.setenv("FEMMECH_CACHE_MAX_BYTES", "lots")
     with pytest.warns(CacheWarning, match="FEMMECH_CACHE_MAX_BYTES='lots'"):
-        assert cache_max_bytes() == cache_module.DEFAULT_MAX_BYTES
+        assert cache_max_bytes() == cache_folder.DEFAULT_MAX_BYTES
 
 
 # --- the key: every setting that changes a reduction ----------------------------------------

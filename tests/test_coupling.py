@@ -23,7 +23,7 @@ from femmech.mechanisms import (
     quasi_modes,
     rheolinear,
 )
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 from femmech.solve.eigen import solve_symmetric
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
@@ -356,12 +356,12 @@ def test_batched_angle_matrices_equal_per_angle_assembly(cam_model):
 
 @pytest.mark.parametrize("n_modes", [3, 8])
 def test_dense_symmetric_drivers_agree(monkeypatch, n_modes):
-    # femmech.solve.eigen.dense_symmetric solves the shift-inverted pencil for all pairs
+    # femmech.solve.dense.dense_symmetric solves the shift-inverted pencil for all pairs
     # (sygvd, 8 of 30 wanted) or the wanted ones (sygvx, 3 of 30, the sweep's frozen-angle
     # solves): both give the same lowest pairs to round-off, with a massless coordinate
     # (infinite λ, dropped) and with a rigid-body mode (singular C: its μ = 1/(0 - σ)
     # dominates, and the round-off of the others grows to ~eps·λ/|σ|, here ~1e-11).
-    from femmech.solve import eigen
+    from femmech.solve import dense
     rng = np.random.default_rng(7)
     n = 30
     A, B = rng.standard_normal((n, n)), rng.standard_normal((n, n))
@@ -369,12 +369,12 @@ def test_dense_symmetric_drivers_agree(monkeypatch, n_modes):
     M[-1], M[:, -1] = 0.0, 0.0
     C = A @ A.T + n * np.eye(n)
     free = np.eye(n) - np.full((n, n), 1.0 / n)  # removes the rigid motion (1, ..., 1)
-    assert 3 < eigen.ALL_PAIRS_FRACTION * n < 8
+    assert 3 < dense.ALL_PAIRS_FRACTION * n < 8
     for stiffness, rtol in ((C, 1e-12), (free @ C @ free, 1e-9)):
-        lam, V = eigen.dense_symmetric(stiffness, M, n_modes)
+        lam, V = dense.dense_symmetric(stiffness, M, n_modes)
         other = 2.0 if n_modes == 8 else 0.0  # the other driver
-        monkeypatch.setattr(eigen, "ALL_PAIRS_FRACTION", other)
-        lam_ref, V_ref = eigen.dense_symmetric(stiffness, M, n_modes)
+        monkeypatch.setattr(dense, "ALL_PAIRS_FRACTION", other)
+        lam_ref, V_ref = dense.dense_symmetric(stiffness, M, n_modes)
         monkeypatch.undo()
         assert lam.size == n_modes
         assert_allclose(lam, lam_ref, rtol=rtol, atol=1e-12 * lam[-1])

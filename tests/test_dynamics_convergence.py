@@ -20,14 +20,10 @@ from numpy.testing import assert_allclose
 from test_stability import _beam  # simply supported 1 m beam, uy bending
 
 import femmech as fm
+from femmech.analysis.floquet import coupled_floquet, coupled_monodromy, monodromy
+from femmech.analysis.magnus import expm_stack
 from femmech.analysis.response import periodic_steady_state, rayleigh_damping
-from femmech.analysis.stability import (
-    coupled_floquet,
-    coupled_monodromy,
-    expm_stack,
-    monodromy,
-    stability_chart,
-)
+from femmech.analysis.stability import stability_chart
 from femmech.coupling import Attachment, Mount, couple, drive_breakpoints
 from femmech.mechanisms import (
     CamProfile,
@@ -42,8 +38,8 @@ from femmech.mechanisms import (
     position_function,
     rheolinear,
 )
-from femmech.output.diagrams import stability_figure
-from femmech.reduction.reduce import craig_bampton
+from femmech.output.stability_charts import stability_figure
+from femmech.reduction.component_modes import craig_bampton
 from femmech.scene.build import prepare
 from femmech.scene.load import Scene, load_scene
 from femmech.scene.run import run_scene
@@ -173,9 +169,9 @@ def test_coupled_cam_machine_converges_at_fourth_order_with_joints_on_step_bound
 
     aligned = errors()
     assert np.all(aligned[:-1] / aligned[1:] > 10)  # 16 for fourth order
-    import femmech.analysis.stability as stability
+    import femmech.analysis.floquet as floquet
 
-    monkeypatch.setattr(stability, "drive_breakpoints", lambda *_: np.zeros(0))
+    monkeypatch.setattr(floquet, "drive_breakpoints", lambda *_: np.zeros(0))
     across = errors()
     assert across[-1] > 10 * aligned[-1]
 

@@ -24,7 +24,7 @@ from femmech.mechanisms import (
     rheolinear,
     second_kind,
 )
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 
 W = 2 * np.pi * 5.0  # 5 rev/s: cam harmonics below the 62 Hz first frame mode
 

@@ -1,7 +1,7 @@
 """Block Lanczos with partial reorthogonalisation, ordering reuse of the Sturm check and
 chunked shell element batches (issue 10, item 1 and 3).
 
-References: dense LAPACK on the same pencil (:func:`femmech.solve.eigen.dense_symmetric`,
+References: dense LAPACK on the same pencil (:func:`femmech.solve.dense.dense_symmetric`,
 shift-inverted, relative accuracy ~eps for the lowest modes), ARPACK (``_arpack``) and a
 fresh factorisation of each backend. Tolerances name what limits them: eigenvalues of a
 backward-stable solve are exact for a pencil perturbed by ~eps ‖K‖, so they carry an absolute
@@ -22,11 +22,13 @@ from roundoff import EPS, eigenvalue_atol
 
 import femmech as fm
 import femmech.fe.elements.shell as shell
-import femmech.solve.eigen as linalg
 from femmech.fe import sections
 from femmech.fe.generators import grid_frame
-from femmech.solve import direct
-from femmech.solve.eigen import dense_symmetric, factorize, solve_symmetric
+from femmech.solve import arpack, cholmod, direct, lanczos, pardiso, superlu
+from femmech.solve.dense import dense_symmetric
+from femmech.solve.eigen import solve_symmetric
+from femmech.solve.pencil import default_shift, eigenvalue_scale, factorize
+from femmech.solve.residuals import residuals
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
 BACKENDS = [pytest.param(name, marks=pytest.mark.skipif(
@@ -57,7 +59,7 @@ def tube_cantilever(n=100):
 def pencil():
     model = frame()
     K, M = model.K_free, model.M_free
-    sigma = linalg.default_shift(K, M)
+    sigma = default_shift(K, M)
     lam, X = dense_symmetric(K, M, 40, sigma=sigma)
     return K, M, sigma, lam, factorize(K - sigma * M, solver="superlu")
 
@@ -67,7 +69,7 @@ def pencil():
                          ids=["partial", "full", "restarted", "b1", "b4"])
 def test_block_lanczos_matches_dense(pencil, variant):
     K, M, sigma, ref, lu = pencil
-    omega2, X = linalg._block_lanczos(K, M, 14, sigma, lu, n_wanted=12, **variant)
+    omega2, X = lanczos._block_lanczos(K, M, 14, sigma, lu, n_wanted=12, **variant)
     # Ritz residuals <= 1e-12 |θ| give eigenvalue errors ~1e-14; both solvers' round-off
     # ~eps λ_max absolute: 10 eps λ_max = 7.6e-11 of λ_1 (module docstring), within 1e-10.
     # Measured 5.3e-14 for every variant
@@ -76,7 +78,7 @@ def test_block_lanczos_matches_dense(pencil, variant):
     # M-orthonormal Ritz vectors: measured 2e-15 (full), 1e-10 (partial: a semi-orthogonal
     # basis, |VᵀMV - I| <= sqrt(eps) by construction)
     assert np.abs(gram - np.eye(len(omega2))).max() < 1e-8
-    res = linalg.residuals(K, M, omega2, X, 1e-6 * linalg.eigenvalue_scale(K, M))
+    res = residuals(K, M, omega2, X, 1e-6 * eigenvalue_scale(K, M))
     # limited by the semi-orthogonal basis (|VᵀMV - I| <= sqrt(eps) = 1.5e-8), not by the
     # BLAS: measured 2e-11 .. 1.4e-10; 1.1e-8 .. 1.9e-8 after a restart (every kernel tried)
     assert res[:12].max() < 1e-7
@@ -86,10 +88,10 @@ def test_block_lanczos_agrees_with_arpack_on_a_larger_frame():
     # 1 494 DOFs, 20 modes + guards: the production path of solve_symmetric
     model = frame(4)
     K, M = model.K_free, model.M_free
-    sigma = linalg.default_shift(K, M)
+    sigma = default_shift(K, M)
     lu = factorize(K - sigma * M, solver="superlu")
-    ref, _ = linalg._arpack(K, M, 24, sigma, lu)
-    omega2, _ = linalg._block_lanczos(K, M, 24, sigma, lu, n_wanted=20)
+    ref, _ = arpack._arpack(K, M, 24, sigma, lu)
+    omega2, _ = lanczos._block_lanczos(K, M, 24, sigma, lu, n_wanted=20)
     # both round-off of the same pencil, ~eps λ_max absolute: 10 eps λ_max is 1.3e-10 of λ_1
     # and 1.8e-12 of λ_20 (measured 2e-15; rtol 1e-12 was below the bound for λ_1..λ_9)
     assert_allclose(omega2[:20], ref[:20], rtol=0, atol=eigenvalue_atol(K, M))
@@ -100,10 +102,10 @@ def test_block_lanczos_returns_both_members_of_double_eigenvalues():
     # only from round-off, late; a block of two finds both in one run (no Sturm restart).
     model = tube_cantilever()
     K, M = model.K_free, model.M_free
-    sigma = linalg.default_shift(K, M)
+    sigma = default_shift(K, M)
     lu = factorize(K - sigma * M, solver="superlu")
-    omega2, _ = linalg._block_lanczos(K, M, 8, sigma, lu, n_wanted=6)
-    ref, _ = linalg._arpack(K, M, 8, sigma, lu)  # ARPACK at machine-precision tolerance
+    omega2, _ = lanczos._block_lanczos(K, M, 8, sigma, lu, n_wanted=6)
+    ref, _ = arpack._arpack(K, M, 8, sigma, lu)  # ARPACK at machine-precision tolerance
     # round-off of both, ~eps λ_max absolute: 10 eps λ_max = 1.8e-4 rad²/s², i.e. 3.4e-7 of
     # the first pair (5 287 rad²/s²) and 1e-9 of the third; a missed member would differ by
     # the gap to the next pair, a factor 39 (measured 1.5e-13 relative; the old rtol 1e-12
@@ -121,8 +123,8 @@ def test_block_lanczos_returns_both_members_of_double_eigenvalues():
 
 def test_deflated_block_lanczos_finds_the_next_modes(pencil):
     K, M, sigma, ref, lu = pencil
-    first, X = linalg._block_lanczos(K, M, 4, sigma, lu)
-    more, _ = linalg._block_lanczos(K, M, 4, sigma, lu, deflate=X)
+    first, X = lanczos._block_lanczos(K, M, 4, sigma, lu)
+    more, _ = lanczos._block_lanczos(K, M, 4, sigma, lu, deflate=X)
     # round-off of both solvers, 10 eps λ_max = 7.6e-11 of λ_1 (module docstring);
     # measured 5e-14
     assert_allclose(np.sort(np.concatenate([first, more])), ref[:8], rtol=1e-10)
@@ -161,7 +163,7 @@ def test_sturm_check_factorises_on_the_shift_ordering(monkeypatch, name):
         return factorize_(*args, **kwargs)
 
     monkeypatch.setattr(direct, "factorize", counting_factorize)
-    for cls in (direct.SuperLUFactor, direct.CholmodFactor, direct.PardisoFactor):
+    for cls in (superlu.SuperLUFactor, cholmod.CholmodFactor, pardiso.PardisoFactor):
         monkeypatch.setattr(cls, "factorize_like", _counted(cls.factorize_like, calls))
     with direct.use(name):
         result = solve_symmetric(K, M, n_modes=10)
@@ -181,12 +183,12 @@ def test_pardiso_blocks_on_a_sparse_factor_are_solved_column_by_column(pencil, m
     K, M, sigma, _, _ = pencil
     A = (K - sigma * M).tocsc()
     f = direct.factorize(A, "pardiso", definite=True)
-    assert f.iparm[17] < direct.PARDISO_LOOP_FILL * f.n  # a beam frame: a sparse factor
+    assert f.iparm[17] < pardiso.PARDISO_LOOP_FILL * f.n  # a beam frame: a sparse factor
     rng = np.random.default_rng(5)
     block = rng.standard_normal((K.shape[0], 40))
     looped = np.column_stack([f.solve(block[:, j]) for j in range(40)])
     assert np.array_equal(f.solve(block), looped)  # the same single solves
-    monkeypatch.setattr(direct, "PARDISO_LOOP_FILL", 0)  # as for a dense (shell) factor
+    monkeypatch.setattr(pardiso, "PARDISO_LOOP_FILL", 0)  # as for a dense (shell) factor
     x = f.solve(block)  # PARDISO's multi-right-hand-side solve
     assert np.abs(A @ x - block).max() < 1e-9 * np.abs(block).max()  # backward error ~eps cond
 
@@ -248,7 +250,7 @@ def test_far_default_shift_is_moved_towards_the_wanted_eigenvalues():
     coordinates (1e13 N/m on 1 kg each, like stiff contacts): the default shift
     -1e-6 median(K_ii/M_ii) = -1e7 lies 1e5 times further below zero than λ_1 is above
     it, so θ = 1/(λ - σ) of the 20 wanted differ by 1 % only. The solver moves σ to
-    -max(λ_1, 1e-3 |σ|) = -1e4 (linalg.FAR_SHIFT) and factorises again; the result
+    -max(λ_1, 1e-3 |σ|) = -1e4 (lanczos.FAR_SHIFT) and factorises again; the result
     equals the dense reference and passes the Sturm check."""
     n_chain, k_chain = 500, 1e7
     main = np.full(n_chain, 2 * k_chain)
@@ -258,8 +260,8 @@ def test_far_default_shift_is_moved_towards_the_wanted_eigenvalues():
     K = sp.block_diag([chain, sp.diags(np.full(3 * n_chain, 1e13))]).tocsr()
     M = sp.identity(4 * n_chain, format="csr")
     lam = np.linalg.eigvalsh(chain.toarray())  # the stiff ones are all 1e13
-    default = linalg.default_shift(K, M)
-    assert -default > 1e4 * lam[0]  # far below: the case of linalg.FAR_SHIFT
+    default = default_shift(K, M)
+    assert -default > 1e4 * lam[0]  # far below: the case of lanczos.FAR_SHIFT
     result = solve_symmetric(K, M, n_modes=20)
     assert result.sigma == pytest.approx(-1e-3 * -default)  # moved, bounded by 1e-3 |σ|
     assert result.sturm_count == result.omega2.size == 20
@@ -274,7 +276,7 @@ def test_arpack_takes_over_where_block_lanczos_does_not_converge(pencil, monkeyp
     round-off of the shift-inverted pencil)."""
     K, M, _, _, _ = pencil
     expected = dense_symmetric(K, M, 8)[0]
-    monkeypatch.setattr(linalg, "MAX_SOLVES_PER_MODE", -10**9)
+    monkeypatch.setattr(lanczos, "MAX_SOLVES_PER_MODE", -10**9)
     with pytest.warns(fm.FemmechWarning, match="falling back to ARPACK"):
         result = solve_symmetric(K, M, n_modes=8, dense_below=0)
     assert result.sturm_count == result.omega2.size >= 8

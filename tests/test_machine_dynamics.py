@@ -14,6 +14,7 @@ from numpy.testing import assert_allclose
 from scipy.integrate import cumulative_simpson, solve_ivp
 from test_stability import PARAMS, _beam, damped_cam_system  # noqa: F401 (fixture)
 
+from femmech.analysis.floquet import coupled_monodromy, floquet, quasi_modal_basis
 from femmech.analysis.forces import drive_forces, support_reactions
 from femmech.analysis.response import (
     ConstantSpeed,
@@ -21,17 +22,11 @@ from femmech.analysis.response import (
     rayleigh_coefficients,
     rayleigh_damping,
 )
-from femmech.analysis.stability import (
-    coupled_monodromy,
-    floquet,
-    quasi_modal_basis,
-    resonance_speeds,
-    stability_chart,
-)
+from femmech.analysis.stability import resonance_speeds, stability_chart
 from femmech.coupling import Attachment, Mount, couple
 from femmech.mechanisms import CamProfile, CamSegment, harmonic, rheolinear, second_kind
-from femmech.output.diagrams import plot_orbit, plot_time_histories, write_history_csv
-from femmech.reduction.reduce import craig_bampton
+from femmech.output.histories import plot_orbit, plot_time_histories, write_history_csv
+from femmech.reduction.component_modes import craig_bampton
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

@@ -1,6 +1,6 @@
 """Substructure reduction (issue 3): Guyan and Craig-Bampton superelements.
 
-References are independent of :mod:`femmech.reduction.reduce`: the full model solved directly
+References are independent of :mod:`femmech.reduction`: the full model solved directly
 (sparse static solve of ``K_free``, dense ``scipy.linalg.eigh`` of ``K_free, M_free`` on
 small grid frames, the shift-invert solver :func:`femmech.modes` on the 1116-DOF shipped
 machine frame), dense ``eigh`` of the fixed-interface pencil ``K_ii, M_ii``, and the
@@ -26,11 +26,14 @@ import scipy.sparse.linalg as spla
 from numpy.testing import assert_allclose, assert_array_equal, assert_array_less
 
 import femmech as fm
+import femmech.reduction as reduction
 from femmech.errors import FileFormatError
 from femmech.fe import sections
 from femmech.fe.generators import grid_frame
-from femmech.reduction import reduce as reduction
-from femmech.reduction.reduce import Superelement, craig_bampton, frequency_error_estimates, guyan
+from femmech.reduction import products
+from femmech.reduction.component_modes import craig_bampton, guyan
+from femmech.reduction.estimate import frequency_error_estimates
+from femmech.reduction.superelement import Superelement
 
 EPS = np.finfo(float).eps
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
@@ -506,14 +509,14 @@ def test_repeated_fixed_interface_modes(cube):
 @pytest.mark.parametrize("residual_vectors", [False, True])
 def test_projection_in_column_blocks_equals_the_dense_projection(grid, monkeypatch,
                                                                 residual_vectors):
-    # the blocked symmetric products (interfaces wider than reduction.SYMMETRIC_BLOCK)
+    # the blocked symmetric products (interfaces wider than products.SYMMETRIC_BLOCK)
     # and the in-place updates give the Galerkin projection Tᵀ K T, Tᵀ M T of the
     # superelement's own basis T = [[I, 0], [Ψ, Φ]], formed here with dense matrices
     model = grid[0]
-    monkeypatch.setattr(reduction, "SYMMETRIC_BLOCK", 7)  # 3 + uneven blocks of n_b
+    monkeypatch.setattr(products, "SYMMETRIC_BLOCK", 7)  # 3 + uneven blocks of n_b
     se = craig_bampton(model, "top", n_modes=6, residual_vectors=residual_vectors)
     n_b = se.Psi.shape[1]
-    assert n_b > 2 * reduction.SYMMETRIC_BLOCK
+    assert n_b > 2 * products.SYMMETRIC_BLOCK
     K, M = model.K_free.toarray(), model.M_free.toarray()
     T = np.zeros((model.n_free, n_b + se.Phi.shape[1]))
     T[se.free_interface, np.arange(n_b)] = 1.0

@@ -5,7 +5,7 @@ import numpy as np
 
 import femmech as fm
 from femmech.fe import sections
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 
 
 def test_reprs_are_one_line_summaries():

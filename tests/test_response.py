@@ -26,7 +26,7 @@ from femmech.mechanisms import (
     position_function,
     rheolinear,
 )
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 
 M1, K1, B1, F1 = 2.0, 800.0, 4.0, 10.0  # kg, N/m, N s/m, N: ω₀ = 20 rad/s, ζ = 0.05
 

@@ -17,7 +17,7 @@ from femmech.coupling import Attachment, Mount, couple
 from femmech.fe import sections
 from femmech.fe.dofs import COMPONENTS
 from femmech.mechanisms import Load, Mechanism, PointMass, RotaryInertia, rheolinear
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 from femmech.reduction.substructures import assemble_parts
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)

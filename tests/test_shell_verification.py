@@ -332,7 +332,7 @@ def test_craig_bampton_reduction_of_a_shell_plate():
     # to 2x the band plus residual vectors resolves the 6 lowest elastic modes to
     # below 0.1 % (measured 1e-8 ... 8.4e-4 with only 12 interface DOFs).
     from femmech.analysis.modes import superelement_modes
-    from femmech.reduction.reduce import craig_bampton
+    from femmech.reduction.component_modes import craig_bampton
 
     mesh = plate_mesh(16)
     model = fm.build_model(mesh, shells={"plate": fm.ShellProperty(0.01, STEEL)})

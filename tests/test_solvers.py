@@ -25,9 +25,12 @@ from threadpoolctl import threadpool_info, threadpool_limits
 import femmech as fm
 from femmech.fe import sections
 from femmech.fe.generators import grid_frame
-from femmech.reduction.reduce import craig_bampton
-from femmech.solve import direct, lobpcg, threads
-from femmech.solve.eigen import eigenvalue_scale, factorize, inertia_below, solve_symmetric
+from femmech.reduction.component_modes import craig_bampton
+from femmech.solve import direct, lobpcg, pardiso, threads
+from femmech.solve.eigen import solve_symmetric
+from femmech.solve.factor import Factor
+from femmech.solve.pencil import eigenvalue_scale, factorize
+from femmech.solve.sturm import inertia_below
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_solid_verification import grid_solid  # noqa: E402
@@ -168,16 +171,16 @@ def test_pardiso_thread_settings_may_change_between_calls(pencil):
 
 def test_pardiso_parallel_block_solve_equals_the_column_loop(pencil, monkeypatch):
     # wide blocks on sparse factors are split between copies of the factor solved
-    # concurrently (direct.PARALLEL_SOLVE_COLUMNS); same ordering and values: the same
+    # concurrently (pardiso.PARALLEL_SOLVE_COLUMNS); same ordering and values: the same
     # floating-point operations per column, so the results are bitwise equal
     if "pardiso" not in direct.available():
         pytest.skip("pardiso not installed")
     K, M, _ = pencil
     f = direct.factorize((K + M).tocsc(), "pardiso")
-    assert f.iparm[17] < direct.PARDISO_LOOP_FILL * f.n  # the column loop applies
+    assert f.iparm[17] < pardiso.PARDISO_LOOP_FILL * f.n  # the column loop applies
     b = np.random.default_rng(3).standard_normal((K.shape[0], 9))
     serial = f.solve(b)
-    monkeypatch.setattr(direct, "PARALLEL_SOLVE_COLUMNS", 4)
+    monkeypatch.setattr(pardiso, "PARALLEL_SOLVE_COLUMNS", 4)
     with threads.limit(factor=3):
         parallel = f.solve(b)
     assert len(f._twins) == 2
@@ -255,7 +258,7 @@ def test_default_solver_from_environment_and_use(monkeypatch):
 
 
 def test_linalg_factorize_keeps_superlu_behaviour(pencil):
-    # the SuperLU path of femmech.solve.eigen.factorize is the same call as before the solver
+    # the SuperLU path of femmech.solve.pencil.factorize is the same call as before the solver
     # layer: SuperLU attributes stay reachable and the inertia count is unchanged
     K, M, lam = pencil
     with direct.use("superlu"):
@@ -273,7 +276,7 @@ def test_factor_pickles_as_none(pencil):
     f = direct.factorize((K + M).tocsc(), "superlu")
     assert pickle.loads(pickle.dumps(f)) is None
     se = craig_bampton(frame_model(), "top", n_modes=3)
-    assert isinstance(se.interior_factor, direct.Factor)
+    assert isinstance(se.interior_factor, Factor)
     copy = pickle.loads(pickle.dumps(se))
     assert copy.interior_factor is None
     np.testing.assert_array_equal(copy.K, se.K)

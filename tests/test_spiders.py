@@ -9,7 +9,7 @@ from roundoff import scaled_condition
 import femmech as fm
 from femmech.fe import sections
 from femmech.fe.constraints import interpolation_matrix, rigid_link_matrix
-from femmech.reduction.reduce import craig_bampton, guyan
+from femmech.reduction.component_modes import craig_bampton, guyan
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
 EPS = np.finfo(float).eps

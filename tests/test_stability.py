@@ -24,14 +24,8 @@ from scipy.optimize import brentq
 from scipy.special import mathieu_a, mathieu_b
 
 import femmech as fm
-from femmech.analysis.stability import (
-    StabilityChart,
-    coupled_floquet,
-    coupled_monodromy,
-    floquet,
-    monodromy,
-    stability_chart,
-)
+from femmech.analysis.floquet import coupled_floquet, coupled_monodromy, floquet, monodromy
+from femmech.analysis.stability import StabilityChart, stability_chart
 from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple, drive_breakpoints
 from femmech.fe import sections
@@ -47,7 +41,7 @@ from femmech.mechanisms import (
     position_function,
     rheolinear,
 )
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 
 # (kind, r, q, value, source)
 PUBLISHED = [
@@ -230,7 +224,7 @@ def test_stability_chart_of_damped_mathieu():
 
 
 def test_plot_stability_chart(tmp_path):
-    from femmech.output.diagrams import plot_stability_chart
+    from femmech.output.stability_charts import plot_stability_chart
 
     w0 = 10.0
     speeds = np.linspace(17.0, 23.0, 13)

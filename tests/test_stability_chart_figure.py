@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from femmech.analysis.stability import StabilityChart
-from femmech.output.diagrams import stability_figure
+from femmech.output.stability_charts import stability_figure
 
 RED = (0.8392156862745098, 0.15294117647058825, 0.1568627450980392)  # matplotlib tab:red
 

@@ -57,7 +57,7 @@ def cam_on_beam(c2):
         position_function,
         rheolinear,
     )
-    from femmech.reduction.reduce import craig_bampton
+    from femmech.reduction.component_modes import craig_bampton
 
     x = np.linspace(0.0, 1.0, 21)
     mesh = fm.Mesh.from_lines(np.column_stack([x, 0 * x, 0 * x]),

@@ -9,7 +9,7 @@ from femmech.analysis.modes import superelement_modes
 from femmech.fe import sections
 from femmech.fe.generators import grid_frame
 from femmech.fe.mesh import line_submesh
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 from femmech.reduction.substructures import assemble_parts
 from femmech.solve.eigen import solve_symmetric
 

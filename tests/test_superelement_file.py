@@ -25,8 +25,10 @@ import scipy.sparse as sp
 from numpy.testing import assert_array_equal
 
 from femmech.errors import FileFormatError
-from femmech.reduction.reduce import Superelement, guyan
-from femmech.reduction.superelement_file import FORMAT_VERSION, PSD_RTOL, SYMMETRY_RTOL
+from femmech.reduction.component_modes import guyan
+from femmech.reduction.superelement import Superelement
+from femmech.reduction.superelement_checks import PSD_RTOL, SYMMETRY_RTOL
+from femmech.reduction.superelement_file import FORMAT_VERSION
 
 FUZZ_FILE = Path(__file__).resolve().parent.parent / "benchmarks" / "fuzz_superelement.py"
 

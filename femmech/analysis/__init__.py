@@ -1,1 +1,21 @@
-"""Analyses: modes, sweeps, stability, response."""
+"""Analyses: modes, sweeps, stability, response.
+
+One job per module:
+
+* :mod:`.modes`: free vibration modes of an FE model or a superelement.
+* :mod:`.sweep`: quasi-eigenfrequencies and quasi-modes of a coupled machine over the
+  drive angle.
+* :mod:`.reference`: full (unreduced) coupled reference solves, reduced versus full.
+* :mod:`.magnus`: monodromy matrices by a fourth-order Magnus integrator with step
+  doubling.
+* :mod:`.floquet`: Floquet multipliers and exponents of periodic systems and coupled
+  machines.
+* :mod:`.stability`: stability charts over drive speed (and a parameter), speed studies.
+* :mod:`.response`: forced response in time (generalised-α), periodic steady states.
+* :mod:`.forces`: attachment, drive, support and section forces from time histories.
+* :mod:`.nonlinear`: time integration of the nonlinear mechanism equations (seed 5.2.1).
+* :mod:`.studies`: design studies as independent jobs on an executor (processes, Dask).
+
+Stage 5 (analysis): uses coupling, reduction, fe, mechanisms, solve and errors; nothing
+here writes files (that is :mod:`femmech.output`).
+"""

@@ -20,6 +20,9 @@ direction of the coordinate it belongs to.
 * :func:`beam_section_forces` returns section forces of beam elements in their local
   axes, with the beam convention stated in :class:`SectionForces` (not the coordinate
   convention above).
+
+Stage 5 (analysis): uses analysis.response, coupling, reduction and fe; nothing here writes
+files.
 """
 
 from __future__ import annotations

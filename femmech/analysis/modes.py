@@ -1,4 +1,7 @@
-"""Free vibration modes of an FE model: ``K φ = ω² M φ``."""
+"""Free vibration modes of an FE model: ``K φ = ω² M φ``.
+
+Stage 5 (analysis): uses reduction, fe and solve; nothing here writes files.
+"""
 
 from __future__ import annotations
 
@@ -10,9 +13,11 @@ import scipy.linalg
 from femmech.fe import checks
 from femmech.fe.dofs import DOF_PER_NODE
 from femmech.fe.model import FEModel
-from femmech.reduction.reduce import Superelement, frequency_error_estimates
+from femmech.reduction.estimate import frequency_error_estimates
+from femmech.reduction.superelement import Superelement
 from femmech.solve import direct
-from femmech.solve.eigen import RIGID_TOL, default_shift, eigenvalue_scale, solve_symmetric
+from femmech.solve.eigen import RIGID_TOL, solve_symmetric
+from femmech.solve.pencil import default_shift, eigenvalue_scale
 
 
 @dataclass(frozen=True)
@@ -41,7 +46,7 @@ class ModeSet:
     error_estimate : ndarray (n_modes,) or None
         For modes of a reduced model: a-posteriori estimate of the relative frequency
         error against the unreduced model (see
-        :func:`femmech.reduction.reduce.frequency_error_estimates`).
+        :func:`femmech.reduction.estimate.frequency_error_estimates`).
     solver : str or None
         Sparse direct solver of the shift-invert factorisation (``"superlu"``,
         ``"cholmod"``, ``"pardiso"``; :mod:`femmech.solve.direct`), ``"pyamg"`` for LOBPCG,
@@ -174,7 +179,7 @@ def model_eigenvalue_scale(model: FEModel) -> float:
     """Eigenvalue scale (rad²/s²) of the free system: shift, rigid threshold, residuals.
 
     The smallest, over the DOF components ux ... rz, of the median ratio
-    ``diag K_free / diag M_free`` (:func:`femmech.solve.eigen.eigenvalue_scale` per
+    ``diag K_free / diag M_free`` (:func:`femmech.solve.pencil.eigenvalue_scale` per
     component). One median over all DOFs is ruled by the rotations of thin shells, whose
     inertia ρt³/12 is tiny: at span/thickness 1e4 their ratios are 1e5 times the
     translational ones and 1e13 times the lowest bending eigenvalue, so that the

@@ -4,6 +4,9 @@ The reference is the same machine with the frame as an unreduced
 :class:`~femmech.fe.model.FEModel`: sparse shift-invert ARPACK on the coupled matrices at
 chosen angles (``eigsh`` path of :func:`femmech.solve.eigen.solve_symmetric` with its Sturm
 check for symmetric C; ``scipy.sparse.linalg.eigs`` with a shift for unsymmetric C).
+
+Stage 5 (analysis): uses analysis.sweep, coupling, reduction and solve; nothing here writes
+files.
 """
 
 from __future__ import annotations
@@ -17,8 +20,9 @@ import scipy.sparse.linalg as spla
 
 from femmech.analysis.sweep import SYMMETRY_RTOL, mac_matrix, sweep
 from femmech.coupling import CoupledSystem
-from femmech.reduction.reduce import Superelement
-from femmech.solve.eigen import default_shift, solve_symmetric
+from femmech.reduction.superelement import Superelement
+from femmech.solve.eigen import solve_symmetric
+from femmech.solve.pencil import default_shift
 
 
 def full_modes(system: CoupledSystem, phi: float, n_modes: int, Omega: float = 0.0):
@@ -95,7 +99,7 @@ def compare_coupled(reduced: CoupledSystem, full: CoupledSystem, phi, n_modes: i
                     Omega: float = 0.0) -> Comparison:
     """Compare a reduced coupled machine with its unreduced twin at the angles ``phi``.
 
-    ``reduced`` must have a :class:`~femmech.reduction.reduce.Superelement` frame of the FE
+    ``reduced`` must have a :class:`~femmech.reduction.superelement.Superelement` frame of the FE
     model that is the frame of ``full`` (same mounts); reduced modes are recovered to the
     full coordinates (frame free DOFs, then the mechanisms' own coordinates) for the MAC.
     """

@@ -24,6 +24,9 @@ It is implicit and unconditionally stable, second-order accurate, and its numeri
 dissipation is set by the spectral radius ρ∞ at h → ∞: the stiff frame modes far above
 the excitation are damped (ρ∞ < 1) without touching the resolved low modes, while
 ρ∞ = 1 is the trapezoidal rule (Newmark average acceleration, energy conserving).
+
+Stage 5 (analysis): uses coupling, fe (node and DOF lookup) and errors; nothing here writes
+files.
 """
 
 from __future__ import annotations

@@ -19,6 +19,9 @@ Jobs travel by pickle: pass module-level functions, ``functools.partial`` of the
 objects of module-level classes, not lambdas or closures. Models holding symbolic
 mechanisms (sympy functions created at run time) do not pickle: send a *recipe* (a
 module-level function and its parameters) that builds the model inside the job.
+
+Stage 5 (analysis): uses analysis.stability and .sweep, solve (thread limits) and errors;
+nothing here writes files.
 """
 
 from __future__ import annotations

@@ -13,6 +13,8 @@ keep their identity (they swap order) and veering branches keep theirs (they do 
 Clusters of (nearly) repeated frequencies, whose vectors are any basis of their subspace,
 are compared as subspaces. Growing motions (flutter: complex λ; divergence: λ < 0; Re s > 0)
 are kept and flagged (:attr:`Sweep.unstable`), never reported as plain frequencies.
+
+Stage 5 (analysis): uses coupling and solve; nothing here writes files.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from scipy.optimize import linear_sum_assignment
 
 from femmech.coupling import CoupledSystem
 from femmech.solve import threads
-from femmech.solve.eigen import dense_symmetric
+from femmech.solve.dense import dense_symmetric
 
 SYMMETRY_RTOL = 1e-10
 """C(φ) counts as symmetric when ``max|C - Cᵀ| <= SYMMETRY_RTOL * max|C|``."""

@@ -25,6 +25,8 @@ Units (:func:`unit_findings`, :func:`frequency_findings`)
     mass of the elements, and first natural frequencies outside
     [:data:`FREQ_BELOW_HZ`, :data:`FREQ_ABOVE_HZ`]. A consistent model in any unit
     system (m-kg-s, mm-t-s) passes.
+
+Stage 2 (fe, independent of mechanisms): uses only errors (ModelWarning).
 """
 
 from __future__ import annotations

@@ -15,6 +15,8 @@ Every constraint is a set of equations ``u_dep = G u_indep``; chains (a link who
 master is the slave of another) are resolved by substitution. Fixed and dependent DOFs
 are removed; the reduced matrices are ``Tᵀ K T`` and ``Tᵀ M T``, with no penalty
 stiffness to spoil the conditioning.
+
+Stage 2 (fe, independent of mechanisms): uses only fe.dofs.
 """
 
 from __future__ import annotations

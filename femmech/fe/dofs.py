@@ -1,6 +1,8 @@
 """DOF numbering: node-interleaved, ``dof = 6 * node + component``.
 
 Components are ordered ``ux, uy, uz, rx, ry, rz`` (m and rad).
+
+Stage 2 (fe, independent of mechanisms): imports nothing of femmech.
 """
 
 from __future__ import annotations

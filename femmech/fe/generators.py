@@ -1,4 +1,7 @@
-"""Parametric meshes of machine-like frames, for examples, tests and benchmarks."""
+"""Parametric meshes of machine-like frames, for examples, tests and benchmarks.
+
+Stage 2 (fe, independent of mechanisms): uses only fe.mesh.
+"""
 
 from __future__ import annotations
 

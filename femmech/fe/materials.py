@@ -1,4 +1,7 @@
-"""Isotropic linear-elastic materials (SI units)."""
+"""Isotropic linear-elastic materials (SI units).
+
+Stage 2 (fe, independent of mechanisms): imports nothing of femmech.
+"""
 
 from __future__ import annotations
 

@@ -1,4 +1,7 @@
-"""The mesh: points, cells by type, named cell sets and node sets (meshio conventions)."""
+"""The mesh: points, cells by type, named cell sets and node sets (meshio conventions).
+
+Stage 2 (fe, independent of mechanisms): imports nothing of femmech.
+"""
 
 from __future__ import annotations
 

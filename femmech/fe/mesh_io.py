@@ -1,4 +1,7 @@
-"""Mesh input through meshio (Gmsh .msh, VTU, XDMF, ... anything meshio reads)."""
+"""Mesh input through meshio (Gmsh .msh, VTU, XDMF, ... anything meshio reads).
+
+Stage 2 (fe, independent of mechanisms): uses only fe.mesh (and meshio).
+"""
 
 from __future__ import annotations
 

@@ -3,6 +3,9 @@
 Symbols: K stiffness (N/m, N m/rad), M mass (kg, kg m²), both (n_dof, n_dof) CSR with
 ``n_dof = 6 n_nodes``; constraints are eliminated by ``u = T u_free`` so that the free
 system is ``Tᵀ K T``, ``Tᵀ M T``.
+
+Stage 2 (fe, independent of mechanisms): uses only the fe package (mesh, sections,
+materials, elements, assembly, constraints, lumped items, parts, checks).
 """
 
 from __future__ import annotations
@@ -28,12 +31,11 @@ from femmech.fe.constraints import (
 )
 from femmech.fe.dofs import DOF_PER_NODE, element_dofs, node_dofs
 from femmech.fe.elements.beam import beam_matrices, local_frames
-from femmech.fe.elements.solid import SOLID_TYPES
+from femmech.fe.elements.registry import kinds
 from femmech.fe.lumped import PointMass, Spring
 from femmech.fe.materials import Material
 from femmech.fe.mesh import Mesh
 from femmech.fe.parts import (
-    SHELL_TYPES,
     ShellProperty,
     ShellSet,
     SolidProperty,
@@ -226,12 +228,8 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
     beams = {} if beams is None else beams
     shells = {} if shells is None else shells
     solids = {} if solids is None else solids
-    if not isinstance(mesh, Mesh):
-        raise TypeError(f"mesh must be a Mesh, got {type(mesh).__name__}")
-    if mesh.n_nodes == 0:
-        raise ValueError("the mesh has no nodes")
-    _check_types(beams, masses, springs, supports, rigid_links, interpolating_links)
-    check_part_types(shells, solids)
+    _check_arguments(mesh, beams, masses, springs, supports, rigid_links, interpolating_links,
+                     shells, solids)
     beam_set, Ke, Me, edofs = _beam_blocks(mesh, beams, bool(shells), bool(solids))
     shell_set, shell_stiff, shell_mass = shell_blocks(mesh, shells)
     n_dof = DOF_PER_NODE * mesh.n_nodes
@@ -242,6 +240,46 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
     used[beam_set.cells.ravel()] = True
     for cells in (*shell_set.cells.values(), *solid_set.cells.values()):
         used[cells.ravel()] = True
+    joined, mass_nodes = _lumped_blocks(mesh, masses, springs, stiff_blocks, mass_blocks, used)
+    masters, slaves, labels = _rigid_pairs(mesh, rigid_links)
+    spiders = _spider_nodes(mesh, interpolating_links)
+    for m, s in [(masters, slaves)] + [(np.full(p.size, r), p) for r, p, _, _ in spiders]:
+        used[m] = True
+        used[s] = True
+        joined.extend(zip(m.tolist(), s.tolist(), strict=True))
+    _check_nodes(mesh, used, joined)
+    fixed, eqs = _constraint_equations(mesh, n_dof, supports, masters, slaves, labels, spiders)
+    K = sum(solid_stiff, assemble(stiff_blocks, n_dof)).tocsr()
+    M = sum(solid_mass, assemble(mass_blocks, n_dof)).tocsr()
+    inactive = _inactive_rotations(solid_set, K, M, eqs)
+    T, free = constraint_transform(n_dof, fixed | inactive, eqs)
+    Tt = T.T.tocsr()
+    links = np.array(joined, dtype=np.int64).reshape(-1, 2)
+    checks.warn(model_findings(mesh, beams, masses, springs, supports, rigid_links,
+                               interpolating_links, shells, solids, node_tol=node_tol))
+    return FEModel(mesh, K, M, T, free, beam_set, np.array(mass_nodes, dtype=np.int64), links,
+                   (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr(), shell_set, solid_set,
+                   np.flatnonzero(inactive))
+
+
+def _check_arguments(mesh, beams, masses, springs, supports, rigid_links, interpolating_links,
+                     shells, solids) -> None:
+    """Types of :func:`build_model`'s arguments (TypeError, ValueError for an empty mesh)."""
+    if not isinstance(mesh, Mesh):
+        raise TypeError(f"mesh must be a Mesh, got {type(mesh).__name__}")
+    if mesh.n_nodes == 0:
+        raise ValueError("the mesh has no nodes")
+    _check_types(beams, masses, springs, supports, rigid_links, interpolating_links)
+    check_part_types(shells, solids)
+
+
+def _lumped_blocks(mesh: Mesh, masses, springs, stiff_blocks: list, mass_blocks: list,
+                   used: np.ndarray) -> tuple[list, list]:
+    """Add the blocks of point masses and springs, mark their nodes used.
+
+    Appends to ``stiff_blocks`` and ``mass_blocks`` and sets ``used`` in place; returns the
+    node pairs the springs join and the nodes of the point masses.
+    """
     joined, mass_nodes = [], []
     for item in masses:
         node = node_index(mesh, item.node, "point mass")
@@ -261,13 +299,12 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
         used[b] = True
         joined.append((a, b))
         stiff_blocks.append((node_dofs([a, b])[None, :], np.block([[k, -k], [-k, k]])[None]))
-    masters, slaves, labels = _rigid_pairs(mesh, rigid_links)
-    spiders = _spider_nodes(mesh, interpolating_links)
-    for m, s in [(masters, slaves)] + [(np.full(p.size, r), p) for r, p, _, _ in spiders]:
-        used[m] = True
-        used[s] = True
-        joined.extend(zip(m.tolist(), s.tolist(), strict=True))
-    _check_nodes(mesh, used, joined)
+    return joined, mass_nodes
+
+
+def _constraint_equations(mesh: Mesh, n_dof: int, supports, masters, slaves, labels,
+                          spiders) -> tuple[np.ndarray, EquationSet]:
+    """Mask (n_dof,) of supported DOFs and the equations of rigid and interpolating links."""
     fixed = np.zeros(n_dof, dtype=bool)
     for item in supports:
         fixed |= fixed_mask(mesh.n_nodes, node_indices(mesh, item.nodes, "support"), item.dofs)
@@ -277,17 +314,7 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
         blocked = fixed.copy()
         blocked[eqs.dependent()] = True
         add_interpolating_link(eqs, mesh.points, reference, patch, weights, blocked, label)
-    K = sum(solid_stiff, assemble(stiff_blocks, n_dof)).tocsr()
-    M = sum(solid_mass, assemble(mass_blocks, n_dof)).tocsr()
-    inactive = _inactive_rotations(solid_set, K, M, eqs)
-    T, free = constraint_transform(n_dof, fixed | inactive, eqs)
-    Tt = T.T.tocsr()
-    links = np.array(joined, dtype=np.int64).reshape(-1, 2)
-    checks.warn(model_findings(mesh, beams, masses, springs, supports, rigid_links,
-                               interpolating_links, shells, solids, node_tol=node_tol))
-    return FEModel(mesh, K, M, T, free, beam_set, np.array(mass_nodes, dtype=np.int64), links,
-                   (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr(), shell_set, solid_set,
-                   np.flatnonzero(inactive))
+    return fixed, eqs
 
 
 def _inactive_rotations(solid_set: SolidSet, K, M, eqs: EquationSet) -> np.ndarray:
@@ -330,13 +357,14 @@ def _check_types(beams, masses, springs, supports, rigid_links, interpolating_li
 
 def _beam_blocks(mesh: Mesh, beams: dict[str, BeamProperty], with_shells: bool = False,
                  with_solids: bool = False):
-    known = ("line",) + (SHELL_TYPES if with_shells else ()) + (SOLID_TYPES if with_solids
+    shell_kinds, solid_kinds = kinds("shell"), kinds("solid")
+    known = ("line",) + (shell_kinds if with_shells else ()) + (solid_kinds if with_solids
                                                                else ())
     unsupported = [k for k, v in mesh.cells.items() if k not in known and len(v)]
     if unsupported:
         raise ValueError(f"the mesh has {unsupported} cells, which have no element property;"
                          " build_model supports line (beam) cells, with shell properties"
-                         f" {SHELL_TYPES} cells and with solid properties {SOLID_TYPES}"
+                         f" {shell_kinds} cells and with solid properties {solid_kinds}"
                          " cells")
     lines = mesh.cells.get("line", np.empty((0, 2), dtype=np.int64))
     owner = np.full(len(lines), -1)
@@ -491,7 +519,8 @@ def model_findings(mesh: Mesh, beams=None, masses=(), springs=(), supports=(), r
     joined += [(r, q) for r, p, _, _ in _spider_nodes(mesh, interpolating_links) for q in p]
     points = mesh.points
     materials, sections, element_mass = {}, [], 0.0
-    for props, kinds in ((beams, ("line",)), (shells, SHELL_TYPES), (solids, SOLID_TYPES)):
+    families = ((beams, ("line",)), (shells, kinds("shell")), (solids, kinds("solid")))
+    for props, group_kinds in families:
         for group, prop in props.items():
             m = prop.material
             key = m.name if materials.get(m.name, (m.E, m.rho)) == (m.E, m.rho) \
@@ -500,7 +529,7 @@ def model_findings(mesh: Mesh, beams=None, masses=(), springs=(), supports=(), r
             per_area = prop.section.A if props is beams else \
                 (prop.thickness if props is shells else 1.0)
             for kind, idx in mesh.cell_sets.get(group, {}).items():
-                if kind in kinds and len(idx):
+                if kind in group_kinds and len(idx):
                     cells = mesh.cells[kind][idx]
                     element_mass += m.rho * per_area * float(
                         checks.cell_measure(points, kind, cells).sum())

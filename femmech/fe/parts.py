@@ -9,6 +9,10 @@ tie the beam node to a patch of solid nodes with a
 :class:`~femmech.fe.constraints.InterpolatingLink` (patch deforms freely). Rotational DOFs
 that only solid elements touch carry neither stiffness nor mass; ``build_model`` removes
 them (:attr:`femmech.fe.model.FEModel.inactive`).
+
+Stage 2 (fe, independent of mechanisms): uses fe.mesh, .materials, .dofs and the element
+registry (:mod:`femmech.fe.elements.registry`): every registered shell and solid cell
+kind is assembled here.
 """
 
 from __future__ import annotations
@@ -19,12 +23,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from femmech.fe.dofs import element_dofs
-from femmech.fe.elements.shell import DRILLING, shell_matrices
-from femmech.fe.elements.solid import SOLID_TYPES, assemble_solid
+from femmech.fe.elements.registry import ELEMENTS, kinds
+from femmech.fe.elements.shell import DRILLING
 from femmech.fe.materials import Material
 from femmech.fe.mesh import NODES_PER_CELL, Mesh
-
-SHELL_TYPES = ("triangle", "quad")
 
 
 @dataclass(frozen=True)
@@ -158,17 +160,17 @@ def shell_blocks(mesh: Mesh, shells: dict[str, ShellProperty]):
     if not shells:
         return ShellSet(), [], []
     names = list(shells)
-    _check_groups(mesh, names, ("triangle", "quad"), "shell")
+    _check_groups(mesh, names, kinds("shell"), "shell")
     table = np.array([[p.material.E, p.material.poisson_ratio, p.material.rho, p.thickness,
                        p.drilling] for p in shells.values()])
     cells_by, group_by, thick_by, stiff, mass = {}, {}, {}, [], []
-    for kind in SHELL_TYPES:
+    for kind in kinds("shell"):
         cells = mesh.cells.get(kind)
         if cells is None or not len(cells):
             continue
         owner = _owner(mesh, kind, names, "shell")
         E, nu, rho, t, drill = table[owner].T
-        Ke, Me = shell_matrices(mesh.points, cells, E, nu, rho, t, drilling=drill)
+        Ke, Me = ELEMENTS[kind].matrices(mesh.points, cells, E, nu, rho, t, drilling=drill)
         dofs = element_dofs(cells)
         stiff.append((dofs, Ke))
         mass.append((dofs, Me))
@@ -186,17 +188,17 @@ def solid_parts(mesh: Mesh, solids: dict[str, SolidProperty], n_dof: int):
     if not solids:
         return SolidSet(), [], []
     names = list(solids)
-    _check_groups(mesh, names, SOLID_TYPES, "solid")
+    _check_groups(mesh, names, kinds("solid"), "solid")
     table = np.array([[p.material.E, p.material.poisson_ratio, p.material.rho]
                       for p in solids.values()])
     cells_by, group_by, stiff, mass = {}, {}, [], []
-    for kind in SOLID_TYPES:
+    for kind in kinds("solid"):
         cells = mesh.cells.get(kind)
         if cells is None or not len(cells):
             continue
         owner = _owner(mesh, kind, names, "solid")
         E, nu, rho = table[owner].T
-        K, M = assemble_solid(mesh.points, cells, kind, E, nu, rho, n_dof)
+        K, M = ELEMENTS[kind].matrices(mesh.points, cells, kind, E, nu, rho, n_dof)
         stiff.append(K)
         mass.append(M)
         cells_by[kind] = cells

@@ -6,6 +6,8 @@ principal axes. ``Iy = ∫ z² dA`` resists bending about y (deflection along z)
 ``Iz = ∫ y² dA`` resists bending about z (deflection along y). ``Asy`` and ``Asz`` are
 the effective shear areas for shear forces along y and z; ``None`` means shear-rigid
 (Euler-Bernoulli) in that direction.
+
+Stage 2 (fe, independent of mechanisms): uses only fe.materials.
 """
 
 from __future__ import annotations
@@ -82,22 +84,6 @@ class BeamSection:
         if self.dims:
             return 0.5 * max(self.dims[:2]) if self.shape != "tube" else 0.5 * self.dims[0]
         return float(np.sqrt(self.A / np.pi))
-
-    def outline(self) -> np.ndarray:
-        """Closed outer outline of the section in local (y, z), shape (n, 2), m."""
-        if self.shape in ("circle", "tube", "general"):
-            radius = self.draw_radius
-            t = np.linspace(0.0, 2.0 * np.pi, 24, endpoint=False)
-            return radius * np.column_stack([np.cos(t), np.sin(t)])
-        if self.shape == "i":
-            h, b, tw, tf = self.dims
-            y = [-b / 2, b / 2, b / 2, tw / 2, tw / 2, b / 2, b / 2, -b / 2, -b / 2,
-                 -tw / 2, -tw / 2, -b / 2]
-            z = [-h / 2, -h / 2, -h / 2 + tf, -h / 2 + tf, h / 2 - tf, h / 2 - tf, h / 2,
-                 h / 2, h / 2 - tf, h / 2 - tf, -h / 2 + tf, -h / 2 + tf]
-            return np.column_stack([y, z])
-        b, h = self.dims[:2]
-        return np.array([[-b / 2, -h / 2], [b / 2, -h / 2], [b / 2, h / 2], [-b / 2, h / 2]])
 
 
 def _positive(name: str, **values: float) -> None:

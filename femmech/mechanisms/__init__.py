@@ -2,6 +2,20 @@
 
 The symbols follow the seed chapter (Dresig/Vul'fson, ch. 5): M mass, B damping,
 C stiffness, F force.
+
+* :mod:`.position`: the position-function protocol shared by cams, linkages and tables.
+* :mod:`.motion_laws`: cam motion laws and cam programmes over one revolution.
+* :mod:`.linkages`: slider-crank and four-bar position functions with exact derivatives.
+* :mod:`.tabulated`: user-tabulated position functions (periodic quintic spline).
+* :mod:`.symbolic`: symbolic description of a lumped mechanism (bodies, springs, loads).
+* :mod:`.lagrange`: symbolic equations of motion (2nd kind, mixed type, rheolinear).
+* :mod:`.evaluate`: vectorised numerical evaluation of the symbolic equations.
+* :mod:`.models`: numerical mechanism models (rheolinear, 2nd kind, mixed type).
+* :mod:`.quasi_modes`: quasi-eigenfrequencies and quasi-modes at frozen drive angles.
+* :mod:`.mounted`: mechanisms whose bearings and guides move with an elastic frame.
+* :mod:`.chapter`: built-in models of the seed chapter (Table 5.1, 5.2.3.1, 5.2.3.2).
+
+Stage 2 (mechanisms, independent of fe): imports only its own modules.
 """
 
 from femmech.mechanisms.chapter import (

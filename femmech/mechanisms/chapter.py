@@ -16,6 +16,8 @@ drive. Examples
 ...                    b2=10.0, F2=50.0), {"U": SliderCrank(0.05, 0.2)})
 >>> model.M([0.0, 1.0]).shape
 (2, 2, 2)
+
+Stage 2 (mechanisms, independent of fe): uses mechanisms.symbolic and .motion_laws.
 """
 
 import numpy as np

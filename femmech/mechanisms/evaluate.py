@@ -8,6 +8,8 @@ argument ``arg`` is evaluated numerically, the user's numeric
 argument, and its values U, U', U'', U''' are passed in. So cams, linkages and tabulated
 functions plug into the same compiled equations, and the (slow) symbolic step is done
 once per mechanism and cached.
+
+Stage 2 (mechanisms, independent of fe): uses mechanisms.symbolic and .position.
 """
 
 import functools

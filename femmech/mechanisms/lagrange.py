@@ -16,6 +16,8 @@ place of Σ c_jk q_k) read
     Σ_k m_jk q̈_k + ½ Σ_k Σ_l m_klj q̇_k q̇_l + W_pot,j = Q*_j(q, q̇),   j = 1 … N.
 
 Symbols follow the textbook: M mass, B damping, C stiffness, F force.
+
+Stage 2 (mechanisms, independent of fe): uses only mechanisms.symbolic.
 """
 
 import functools

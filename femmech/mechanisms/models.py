@@ -6,6 +6,9 @@ vectorised over arrays of angles or states. The symbolic derivation and ``lambdi
 cached per mechanism, so building many models with different parameter values is cheap.
 
 Symbols follow the seed chapter: M mass, B damping, C stiffness, F force (5.2.2 eq. 9).
+
+Stage 2 (mechanisms, independent of fe): uses mechanisms.symbolic, .lagrange, .evaluate and
+.position.
 """
 
 from collections.abc import Mapping

@@ -19,6 +19,8 @@ References
 .. [1] R. L. Norton, *Cam Design and Manufacturing Handbook*, 2nd ed., Industrial Press,
    2009, ch. 3 (double-dwell functions) and Table 3-3 (peak values of s', s'', s''').
 .. [2] H. A. Rothbart, *Cam Design Handbook*, McGraw-Hill, 2004, ch. 2.
+
+Stage 2 (mechanisms, independent of fe): uses only mechanisms.position.
 """
 
 from dataclasses import dataclass, field
@@ -310,7 +312,7 @@ class CamProfile:
         The segment joints (where a law meets a dwell the jerk jumps, with the harmonic law
         the acceleration too) and the piece boundaries inside piecewise laws. Time
         integrators over the cycle put step boundaries there: a step across a jump loses
-        the order of the scheme (:mod:`femmech.analysis.stability`).
+        the order of the scheme (:mod:`femmech.analysis.magnus`).
         """
         angles = [np.asarray(self._starts)]
         for start, seg in zip(self._starts, self.segments, strict=True):

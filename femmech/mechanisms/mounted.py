@@ -17,6 +17,8 @@ Coordinates are small displacements (m) or rotations (rad) about the rigid motio
 * slider-crank: ``q_t`` crankshaft twist, ``u_b``/``v_b`` crank-bearing displacement
   along/across the slider axis, ``v_g`` guide displacement across the slider axis,
   ``q`` connecting-rod (output) deformation.
+
+Stage 2 (mechanisms, independent of fe): uses only mechanisms.symbolic.
 """
 
 from __future__ import annotations

@@ -5,6 +5,8 @@ drive angle φ of a rigid mechanism to the position U(φ) of its output member. 
 mechanism equations need U and its first three derivatives with respect to φ: U' and U''
 enter the mass and damping terms, U''' enters the stiffness matrix C (seed chapter
 5.2.2, text after Table 5.1).
+
+Stage 2 (mechanisms, independent of fe): imports nothing of femmech.
 """
 
 from typing import Protocol, runtime_checkable

@@ -10,6 +10,9 @@ eigenfrequencies"). With Ω = Ω̇ = 0 and position-independent loads, C is the 
 potential part and ``scipy.linalg.eigh`` is used; otherwise C is generally unsymmetric
 (errata item 30) and ``scipy.linalg.eig`` is used. Damping B is ignored (undamped
 quasi-modes).
+
+Stage 2 (mechanisms, independent of fe): imports nothing of femmech (matplotlib only inside
+the plot function).
 """
 
 import os

@@ -15,6 +15,8 @@ Position functions of cams and linkages enter as opaque sympy functions made by
 :func:`position_function`: ``U = position_function("U")`` gives a function whose
 derivatives are the opaque functions U', U'', U'''. Their numeric values are supplied
 when the equations are evaluated (see :mod:`femmech.mechanisms.evaluate`).
+
+Stage 2 (mechanisms, independent of fe): imports nothing of femmech.
 """
 
 import functools

@@ -9,6 +9,8 @@ converges as O(h³) for smooth data (de Boor [1]_, ch. XII).
 References
 ----------
 .. [1] C. de Boor, *A Practical Guide to Splines*, rev. ed., Springer, 2001.
+
+Stage 2 (mechanisms, independent of fe): uses only mechanisms.position.
 """
 
 from dataclasses import dataclass, field

@@ -2,12 +2,26 @@
 
 pyvista is imported only inside the plotting functions, so importing this package
 does not import pyvista.
+
+* :mod:`.plot`: off-screen images of mode shapes with pyvista (PNG).
+* :mod:`.machine`: off-screen images of coupled machine modes (frame plus mechanisms).
+* :mod:`.surfaces`: cells of a model by kind for drawing and export.
+* :mod:`.export`: mode shapes to VTU files, and atomic file output.
+* :mod:`.sweeps`: sweeps over the drive angle: MAC matrices (PNG), tables (CSV, JSON).
+* :mod:`.stability_charts`: Floquet stability charts and speed studies (PNG).
+* :mod:`.histories`: time histories and orbits of a forced response (PNG, CSV).
+* :mod:`.tables`: frequency tables of a mode set (text, CSV).
+* :mod:`.report`: one self-contained HTML report page.
+* :mod:`.folder`: one run, one output folder (staging folder and manifest).
+
+Stage 6 (output): uses analysis, coupling, reduction, fe and errors; of femmech only
+:mod:`femmech.scene` imports it.
 """
 
-from femmech.output.diagrams import plot_mac, write_sweep_csv, write_sweep_json
 from femmech.output.export import atomic_path, export_modes_vtu
 from femmech.output.machine import plot_coupled_mode
 from femmech.output.plot import mode_mesh, mode_scale, mode_title, plot_mode, plot_modes
+from femmech.output.sweeps import plot_mac, write_sweep_csv, write_sweep_json
 from femmech.output.tables import frequency_table, write_frequency_csv
 
 __all__ = [

@@ -9,6 +9,8 @@ carried over untouched. A failed or interrupted run leaves the previous folder a
 its staging folder is removed at once, or by the next run into the same folder if the
 process was killed. A folder that is neither empty nor written by femmech is refused, so
 ``--out`` can never make femmech delete a user's files.
+
+Stage 6 (output): uses only errors.
 """
 
 from __future__ import annotations

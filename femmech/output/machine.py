@@ -6,6 +6,8 @@ mechanism is drawn schematically at its first translational attachment: a connec
 from the (displaced) frame node to a block that stands for the mechanism's moving body,
 displaced by the mechanism coordinate of largest amplitude along the attachment
 direction.
+
+Stage 6 (output): uses analysis.modes, coupling, reduction, fe and output.plot.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from femmech.coupling import CoupledSystem, _weights
 from femmech.fe.dofs import DOF_PER_NODE
 from femmech.fe.model import FEModel, node_index
 from femmech.output.plot import SCALE_FRACTION, model_size, plot_mode
-from femmech.reduction.reduce import Superelement
+from femmech.reduction.superelement import Superelement
 
 MECHANISM_COLOR = "#e07b00"
 OFFSET_FRACTION = 0.06

@@ -17,6 +17,8 @@ OSMesa; https://docs.vtk.org/en/latest/advanced/runtime_settings.html). Without 
 display, :func:`plot_mode` sets ``VTK_DEFAULT_OPENGL_WINDOW`` to the EGL window (or to
 OSMesa when only libOSMesa is found) before the first render window is created, unless
 the variable is already set; this skips the failing X attempt and its warning.
+
+Stage 6 (output): uses analysis.modes, fe and output.export and .surfaces.
 """
 
 from __future__ import annotations

@@ -4,6 +4,8 @@ Images (PNG) and data files (CSV, JSON, VTU) are referenced by relative names an
 next to the page, so the folder can be moved or zipped as a whole. The page is written
 atomically (:func:`femmech.output.export.atomic_path`); :func:`write_report` refuses to
 write a page that references a missing file.
+
+Stage 6 (output): uses only output.export.
 """
 
 from __future__ import annotations

@@ -6,6 +6,8 @@ has them (an attribute ``solids`` whose ``cells`` maps meshio cell types to
 connectivity), are drawn by their outer surface: the faces that belong to exactly one
 solid cell. Higher-order solids (``tetra10``, ``hexahedron20``, ...) are drawn with
 their corner nodes, which meshio lists first.
+
+Stage 6 (output): uses only fe.model.
 """
 
 from __future__ import annotations

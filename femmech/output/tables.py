@@ -1,4 +1,7 @@
-"""Frequency tables of a mode set: plain text for reports and logs, CSV for spreadsheets."""
+"""Frequency tables of a mode set: plain text for reports and logs, CSV for spreadsheets.
+
+Stage 6 (output): uses analysis.modes and output.export.
+"""
 
 from __future__ import annotations
 

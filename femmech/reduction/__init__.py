@@ -1,23 +1,25 @@
 """Stage 3, substructure reduction: FE model → small superelement with recovery.
 
-Guyan and Craig-Bampton superelements with residual vectors and an a-posteriori
-frequency error estimate (:mod:`.reduce`), their validated file format
-(:mod:`.superelement_file`), and the assembly of several superelements and plain FE
-parts into one system (:mod:`.substructures`).
+* :mod:`.superelement`: the :class:`Superelement` (reduced matrices, recovery of the full
+  field, save/load) and :func:`interface_dofs`;
+* :mod:`.component_modes`: Guyan and Craig-Bampton reduction with residual vectors;
+* :mod:`.products`: the dense-block products of the reduction;
+* :mod:`.estimate`: the a-posteriori frequency error estimate of a reduction;
+* :mod:`.superelement_file`: the validated file format (writer and reader), with
+  :mod:`.superelement_format` (fields, checksums, messages), :mod:`.superelement_archive`
+  (zip members and ``.npy`` headers) and :mod:`.superelement_checks` (meta, shapes,
+  values);
+* :mod:`.substructures`: the assembly of several superelements and plain FE parts into
+  one system.
 
-Imports :mod:`femmech.fe` and :mod:`femmech.solve`; never mechanisms, coupling or analyses.
+Imports :mod:`femmech.errors`, :mod:`femmech.fe` and :mod:`femmech.solve`; never
+mechanisms, coupling or analyses.
 """
 
-from femmech.reduction.reduce import (
-    CUTOFF_FACTOR,
-    FORMAT_VERSION,
-    Superelement,
-    craig_bampton,
-    frequency_error_estimates,
-    guyan,
-    interface_dofs,
-)
+from femmech.reduction.component_modes import CUTOFF_FACTOR, craig_bampton, guyan
+from femmech.reduction.estimate import frequency_error_estimates
 from femmech.reduction.substructures import Assembly, assemble_parts
+from femmech.reduction.superelement import FORMAT_VERSION, Superelement, interface_dofs
 
 __all__ = [
     "CUTOFF_FACTOR",

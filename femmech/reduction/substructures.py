@@ -5,6 +5,8 @@ of an unreduced :class:`~femmech.fe.model.FEModel`) are the same global DOF when
 coincide (within ``tol`` times the overall size) and their components agree; modal
 coordinates stay private to their superelement. The assembled matrices are sparse;
 superelement blocks enter as dense blocks (primal assembly, Craig & Bampton 1968).
+
+Stage 3 (reduction): imports :mod:`femmech.fe` and its own package.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from scipy.spatial import cKDTree
 
 from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
 from femmech.fe.model import FEModel
-from femmech.reduction.reduce import Superelement
+from femmech.reduction.superelement import Superelement
 
 
 @dataclass(frozen=True)

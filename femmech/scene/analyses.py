@@ -8,6 +8,9 @@ angle, :func:`femmech.analysis.sweep.sweep` or :func:`femmech.mechanisms.quasi_m
 :func:`~femmech.analysis.response.time_response`) and ``check`` (reduced versus full,
 :func:`femmech.analysis.reference.compare_coupled`, optionally over several reduction
 sizes: the speed-versus-error comparison).
+
+Stage 7 (scene), reading: uses scene.reader, scene.units and the defaults of
+analysis.response and analysis.magnus.
 """
 
 from __future__ import annotations
@@ -16,9 +19,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from femmech.analysis.magnus import MAX_STEPS as MONODROMY_MAX_STEPS
+from femmech.analysis.magnus import RTOL as MONODROMY_RTOL
 from femmech.analysis.response import STEADY_STATE_MAX_STEPS, STEADY_STATE_RTOL
-from femmech.analysis.stability import MAX_STEPS as MONODROMY_MAX_STEPS
-from femmech.analysis.stability import RTOL as MONODROMY_RTOL
 from femmech.scene.reader import Reader, show
 from femmech.scene.units import ANGLE, DIMENSIONLESS, FREQUENCY, INVERSE_TIME, SPEED, TIME
 

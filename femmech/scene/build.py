@@ -9,6 +9,9 @@ inputs of each part, :mod:`femmech.fe.checks`) and is what ``femmech check`` run
 steps that :mod:`femmech.scene.run` calls only when an analysis needs them. Errors of the API
 raised here are re-raised as one-line :class:`~femmech.errors.SceneError` naming the
 scene location.
+
+Stage 7 (scene), plan and build: uses scene.load, scene.mechanisms, fe, reduction and
+coupling.
 """
 
 from __future__ import annotations
@@ -43,7 +46,8 @@ from femmech.fe.model import (
     node_indices,
 )
 from femmech.fe.sections import BeamSection
-from femmech.reduction.reduce import CUTOFF_FACTOR, FORMAT_VERSION, craig_bampton, guyan
+from femmech.reduction.component_modes import CUTOFF_FACTOR, craig_bampton, guyan
+from femmech.reduction.superelement import FORMAT_VERSION
 from femmech.scene.load import PartSpec, Scene, fail
 from femmech.scene.mechanisms import confined_module, mechanism_model
 from femmech.version import __version__
@@ -341,7 +345,7 @@ def _section(s) -> BeamSection:
 
 
 def interface(part: PartSpec) -> list:
-    """The interface in the form of :func:`femmech.reduction.reduce.interface_dofs`."""
+    """The interface in the form of :func:`femmech.reduction.superelement.interface_dofs`."""
     return [(i.nodes if isinstance(i.nodes, (str, int)) else list(i.nodes), i.dofs)
             for i in part.reduction.interface]
 
@@ -370,9 +374,9 @@ def reduction_key_data(scene: Scene, part: PartSpec, f_max_hz: float | None = No
     ``edge_node_groups`` and ``merge_nodes``; sections, shells, solids, items; the
     interface and every reduction setting (method, mode selection, residual vectors). Also
     the materials the part uses, the femmech version, the superelement file format and
-    :data:`femmech.reduction.reduce.CUTOFF_FACTOR` (the modes an ``f_max_hz`` keeps). Not in it:
-    the part's name, file paths and scene locations, and the sparse solver backend and
-    thread counts, which change a reduction by round-off only.
+    :data:`femmech.reduction.component_modes.CUTOFF_FACTOR` (the modes an ``f_max_hz``
+    keeps). Not in it: the part's name, file paths and scene locations, and the sparse
+    solver backend and thread counts, which change a reduction by round-off only.
     """
     data = plain(part)
     del data["name"]

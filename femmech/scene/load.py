@@ -1,7 +1,7 @@
 """Scene files: a machine and the analyses wanted, described in one TOML file.
 
 A scene maps onto the Python API (the primary interface): parts → :func:`femmech.build_model`
-(+ :func:`femmech.reduction.reduce.craig_bampton` / ``guyan``), mechanisms →
+(+ :func:`femmech.reduction.component_modes.craig_bampton` / ``guyan``), mechanisms →
 :func:`femmech.mechanisms.rheolinear`, mounts → :class:`femmech.coupling.Mount`, analyses →
 :mod:`femmech.analysis`. :func:`load_scene` reads and validates a file into frozen
 dataclasses (:class:`Scene`); :meth:`Scene.from_dict` does the same for a dict built in
@@ -11,6 +11,9 @@ Python. Checks that need the meshes (group names, node indices) are in
 Values are plain numbers in SI units or strings with units (``"210 GPa"``, see
 :mod:`femmech.scene.units`). The format is described in ``docs/scenes.md``. Every error is a
 one-line :class:`~femmech.errors.SceneError` naming the file, the key and the expectation.
+
+Stage 7 (scene), validation: uses the table readers (scene.reader, .mesh, .machine,
+.analyses), fe.sections and fe.dofs; the result is plain data, nothing is built.
 """
 
 from __future__ import annotations

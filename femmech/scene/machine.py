@@ -5,15 +5,20 @@ function in a user Python module (``module = "my_mech.py"``, ``function = "build
 returning a symbolic :class:`~femmech.mechanisms.Mechanism` (or a ready
 ``RheolinearModel``), with parameter values (SI or unit strings) and position functions
 (cams, linkages). A mount places a mechanism on a part: :class:`femmech.coupling.Mount`.
+
+Stage 7 (scene), reading: uses scene.reader, scene.units, fe.dofs and the factories of
+mechanisms; nothing is built here.
 """
 
 from __future__ import annotations
 
+import inspect
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from femmech.fe.dofs import COMPONENTS
+from femmech.mechanisms import cam_follower, processing_machine, slider_crank, table_5_1_case
 from femmech.scene.reader import Reader, show
 from femmech.scene.units import (
     ANGLE,
@@ -29,9 +34,11 @@ from femmech.scene.units import (
     STIFFNESS,
 )
 
-BUILTIN_MODELS = ("cam_follower", "slider_crank", "table_5_1_case", "processing_machine")
-"""Built-in mechanism models: :func:`femmech.mechanisms.cam_follower`, ``slider_crank``,
-``table_5_1_case`` and ``processing_machine``; ``options`` are their keyword arguments."""
+BUILTIN_MODELS = {"cam_follower": cam_follower, "slider_crank": slider_crank,
+                  "table_5_1_case": table_5_1_case, "processing_machine": processing_machine}
+"""Built-in mechanism models by scene name → factory of :mod:`femmech.mechanisms`;
+``options`` are the factory's keyword arguments (checked against its signature). To offer
+a new mechanism type in scenes, add its factory here (and its roles to ``_ROLE_KINDS``)."""
 
 _ROLE_KINDS = {
     "cam_follower": {"m": ("m", MASS), "c": ("c", STIFFNESS), "c_return": ("c_r", STIFFNESS),
@@ -126,7 +133,7 @@ def read_mechanisms(root: Reader, base: Path) -> dict:
         if r.has("model") == r.has("module"):
             raise r.error(None, "give exactly one of model (built-in: one of"
                                 f" {list(BUILTIN_MODELS)}) and module (a Python file)")
-        model = r.string("model", None, choices=BUILTIN_MODELS)
+        model = r.string("model", None, choices=tuple(BUILTIN_MODELS))
         module = function = None
         if model is None:
             module = base / r.string("module")
@@ -149,10 +156,7 @@ def _options(r: Reader, model: str | None) -> dict:
     built-in models, with a "did you mean")."""
     options = r.get("options", {})
     if isinstance(options, dict) and model is not None:
-        import inspect
-
-        from femmech import mechanisms
-        signature = inspect.signature(getattr(mechanisms, model))
+        signature = inspect.signature(BUILTIN_MODELS[model])
         r.child("options", options).expect(*signature.parameters)
     if not isinstance(options, dict) or not all(
             isinstance(v, (str, int, bool)) for v in options.values()):

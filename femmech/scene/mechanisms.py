@@ -4,6 +4,8 @@ A user module (``module = "my_mech.py"``) is Python code: it runs only when the 
 opts in (``allow_code=True``, ``femmech run --allow-code``), and only from a file inside
 the allowed root (the scene's folder unless the caller names another, ``code_root``).
 See the threat model in docs/robustness.md.
+
+Stage 7 (scene), build: uses scene.load, scene.machine and mechanisms.
 """
 
 from __future__ import annotations
@@ -20,22 +22,17 @@ from femmech.mechanisms import (
     Mechanism,
     RheolinearModel,
     SliderCrank,
-    cam_follower,
     cycloidal,
     harmonic,
     modified_sine,
     modified_trapezoid,
     polynomial_345,
-    processing_machine,
     processing_machine_cams,
     rheolinear,
-    slider_crank,
-    table_5_1_case,
 )
 from femmech.scene.load import fail
+from femmech.scene.machine import BUILTIN_MODELS
 
-FACTORIES = {"cam_follower": cam_follower, "slider_crank": slider_crank,
-             "table_5_1_case": table_5_1_case, "processing_machine": processing_machine}
 LAWS = {"polynomial_345": polynomial_345, "cycloidal": cycloidal, "harmonic": harmonic,
         "modified_sine": modified_sine, "modified_trapezoid": modified_trapezoid}
 
@@ -50,7 +47,7 @@ def mechanism_model(scene, spec, code_root=None) -> RheolinearModel:
     """
     if spec.model is not None:
         try:
-            built = FACTORIES[spec.model](**spec.options)
+            built = BUILTIN_MODELS[spec.model](**spec.options)
         except Exception as exc:  # wrong option names or types: at the scene location
             raise fail(scene, spec.where, "options", f"{type(exc).__name__}: {exc}") from None
     else:

@@ -4,6 +4,9 @@ The sizes a generator would produce are computed from the scene's numbers and ch
 against :data:`femmech.fe.mesh.MAX_NODES` and ``MAX_CELLS`` before anything is allocated;
 members may not overlap and their elements may not be shorter than the near-node distance
 of :mod:`femmech.fe.checks`.
+
+Stage 7 (scene), reading: uses scene.reader, scene.units and fe (generators' sizes,
+mesh checks); nothing is built here.
 """
 
 from __future__ import annotations

@@ -7,7 +7,11 @@ loaded from the cache when the key matches (:mod:`femmech.scene.cache`), and the
 unreduced coupled machine is built only for the full-versus-reduced check. Results go to
 ``out``, which a run replaces as a whole when it succeeds (:mod:`femmech.output.folder`):
 the report page (``report.html``), ``results.json`` (key numbers, no timings: identical
-for identical inputs), ``run.log`` and the files of each analysis."""
+for identical inputs), ``run.log`` and the files of each analysis.
+
+Stage 7 (scene), the top: uses scene.tasks, scene.workshop, scene.build, the cache and
+output; only femmech.cli and the package's __init__ import it.
+"""
 
 from __future__ import annotations
 
@@ -30,7 +34,7 @@ from femmech.scene.build import (
     finding_lines,
     prepare,
 )
-from femmech.scene.cache import default_cache_dir
+from femmech.scene.cache_folder import default_cache_dir
 from femmech.scene.load import Scene, load_scene
 from femmech.scene.tasks import TASKS, summary_section
 from femmech.scene.workshop import Workshop, progress
@@ -42,7 +46,7 @@ LOG = logging.getLogger("femmech.run")
 and above (``-q``: WARNING and above, ``-v``: everything)."""
 
 DEFAULT = object()
-"""Marker: use :func:`femmech.scene.cache.default_cache_dir`."""
+"""Marker: use :func:`femmech.scene.cache_folder.default_cache_dir`."""
 
 
 @dataclass(frozen=True)
@@ -84,7 +88,8 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
         Output folder: created (with its parents) if missing; an existing one must be
         empty or written by an earlier run (InputError otherwise).
     cache_dir : path or None
-        Reduction cache; default :func:`femmech.scene.cache.default_cache_dir`, None: no cache.
+        Reduction cache; default :func:`femmech.scene.cache_folder.default_cache_dir`,
+        None: no cache.
     log : callable, optional
         Also receives each log line as it happens (e.g. ``print``); the lines always go
         to the logger ``femmech.run`` (:data:`LOG`) as well.

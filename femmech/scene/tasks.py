@@ -4,6 +4,9 @@
 Each task takes ``(workshop, spec, out)``; see :mod:`femmech.scene.run` for the workshop
 (lazy FE models, cached reductions, coupled machines) and :mod:`femmech.scene.analyses`
 for the specs.
+
+Stage 7 (scene), compute and write: uses scene.workshop, scene.build, analysis, output,
+coupling and mechanisms.
 """
 
 from __future__ import annotations
@@ -33,9 +36,9 @@ from femmech.errors import ConvergenceWarning
 from femmech.fe.model import node_index
 from femmech.mechanisms import plot_quasi_frequencies, quasi_modes
 from femmech.output import export_modes_vtu, frequency_table, plot_mac, write_frequency_csv
-from femmech.output.diagrams import plot_stability_chart
 from femmech.output.export import atomic_path
 from femmech.output.report import Figure, Flagged, Section, Table
+from femmech.output.stability_charts import plot_stability_chart
 from femmech.scene.build import machine_mounts
 from femmech.scene.workshop import progress, timings_table
 

@@ -5,6 +5,9 @@ part's FE model is assembled only when an analysis or a cache miss needs it, its
 reduction is loaded from the cache when the key matches (:mod:`femmech.scene.cache`), and
 the unreduced coupled machine is built only for the full-versus-reduced check. The
 analyses (:mod:`femmech.scene.tasks`) take a workshop and ask it for what they need.
+
+Stage 7 (scene), compute: uses scene.build, scene.cache, fe, reduction, coupling and
+output.report.
 """
 
 from __future__ import annotations

@@ -17,6 +17,9 @@ No Sturm count is possible without a factorisation: the result is checked by its
 residuals only (:attr:`femmech.solve.eigen.EigenResult.sturm_count` is None). LOBPCG converges to
 the lowest eigenvalues from a random start in practice, but a mode can in principle be
 missed; use shift-invert (:func:`femmech.solve.eigen.solve_symmetric`) where memory allows.
+
+Stage 1, solve (linear algebra): imports only :mod:`femmech.errors` and other
+:mod:`femmech.solve` modules, never :mod:`femmech.fe` or higher.
 """
 
 from __future__ import annotations
@@ -28,7 +31,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from femmech.errors import FemmechWarning
-from femmech.solve.eigen import EigenResult, eigenvalue_scale, normalize_modes, residuals
+from femmech.solve.eigen import EigenResult
+from femmech.solve.pencil import eigenvalue_scale
+from femmech.solve.residuals import normalize_modes, residuals
 
 DOF_PER_NODE = 6
 
@@ -137,9 +142,9 @@ def lobpcg_symmetric(K, M, n_modes: int, B: np.ndarray | None = None, blocksize:
         DOFs per node for block aggregation (:func:`node_blocksize`).
     rtol : float
         Convergence tolerance of LOBPCG's residual norms ``‖K x / s - μ M x‖`` (``s``:
-        :func:`~femmech.solve.eigen.eigenvalue_scale`, ``μ = λ / s``, ``xᵀMx = 1``). Eigenvalue
-        errors go like its square: on a 2 100-DOF solid block 1e-8 gave frequencies within
-        1e-12 of shift-invert, 1e-6 within 3e-8 (tests/test_solvers.py).
+        :func:`~femmech.solve.pencil.eigenvalue_scale`, ``μ = λ / s``, ``xᵀMx = 1``).
+        Eigenvalue errors go like its square: on a 2 100-DOF solid block 1e-8 gave
+        frequencies within 1e-12 of shift-invert, 1e-6 within 3e-8 (tests/test_solvers.py).
     maxiter : int
         LOBPCG iterations at most.
     extra : int, optional
@@ -153,8 +158,8 @@ def lobpcg_symmetric(K, M, n_modes: int, B: np.ndarray | None = None, blocksize:
     EigenResult
         ``method="lobpcg"``, ``solver="pyamg"``, ``sigma``: the shift of the multigrid
         matrix ``K - σM``; ``sturm_count`` None; ``residual`` as in
-        :func:`~femmech.solve.eigen.residuals`. A FemmechWarning is issued if LOBPCG stopped
-        before reaching ``rtol``.
+        :func:`~femmech.solve.residuals.residuals`. A FemmechWarning is issued if LOBPCG
+        stopped before reaching ``rtol``.
     """
     n = K.shape[0]
     if isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer)) \

@@ -16,6 +16,9 @@ Override for the whole process with the environment variable ``FEMMECH_THREADS``
 phase alone), for a block of code with :func:`limit`, or permanently with :func:`set_threads`.
 The limits are applied through threadpoolctl to every loaded BLAS (OpenBLAS, MKL, BLIS)
 and OpenMP runtime (MKL PARDISO and CHOLMOD thread through them).
+
+Stage 1, solve (linear algebra): imports only :mod:`femmech.errors` and other
+:mod:`femmech.solve` modules, never :mod:`femmech.fe` or higher.
 """
 
 from __future__ import annotations

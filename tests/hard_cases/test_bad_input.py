@@ -234,7 +234,7 @@ def test_unknown_group_is_named_with_the_known_ones(name, where):
     elif where == "rigid link":
         call = lambda: build(rigid_links=[fm.RigidLink(4, name)])  # noqa: E731
     else:
-        from femmech.reduction.reduce import guyan
+        from femmech.reduction.component_modes import guyan
 
         call = lambda: guyan(build(), [name])  # noqa: E731
     raises_clean(call, repr(name))

@@ -31,7 +31,7 @@ from femmech.mechanisms import (
     position_function,
     rheolinear,
 )
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 
 SQUARE = sections.rectangular_hollow(0.06, 0.06, 0.004)
 

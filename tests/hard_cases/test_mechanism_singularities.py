@@ -29,7 +29,7 @@ from femmech.mechanisms import (
     rheolinear,
 )
 from femmech.mechanisms.mounted import slider_crank
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 
 PRESS = {"J1": 1.5, "m2": 150.0, "c1": 1e6, "c2": 1e9, "b1": 0.0, "b2": 0.0, "F2": 0.0,
          "r": 0.05, "l": 0.35, "e": 0.0}  # kg m², kg, N m/rad, N/m, ..., m

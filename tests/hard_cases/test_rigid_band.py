@@ -21,7 +21,7 @@ from numpy.testing import assert_allclose
 import femmech as fm
 from femmech.analysis.modes import model_eigenvalue_scale, superelement_modes
 from femmech.fe.generators import grid_frame
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 from femmech.solve.eigen import RIGID_TOL, solve_symmetric
 
 

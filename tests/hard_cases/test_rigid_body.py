@@ -29,8 +29,8 @@ from femmech.analysis.sweep import sweep
 from femmech.coupling import Attachment, Mount, couple
 from femmech.fe import sections
 from femmech.mechanisms import rheolinear
-from femmech.reduction.reduce import craig_bampton, guyan
-from femmech.solve.eigen import inertia_below
+from femmech.reduction.component_modes import craig_bampton, guyan
+from femmech.solve.sturm import inertia_below
 
 
 @pytest.mark.parametrize(("subdivisions", "method"), [(3, "dense"), (8, "arpack")])

@@ -33,7 +33,7 @@ from femmech.mechanisms import (
     position_function,
     rheolinear,
 )
-from femmech.reduction.reduce import craig_bampton, guyan
+from femmech.reduction.component_modes import craig_bampton, guyan
 
 MASSLESS_STEEL = fm.Material(E=210e9, nu=0.3, rho=0.0, name="massless steel")
 

@@ -26,7 +26,7 @@ from roundoff import largest_eigenvalue
 import femmech as fm
 from femmech.analysis.modes import superelement_modes
 from femmech.fe import sections
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 
 K_BEARING, K_MOUNT, K_MOUNT_ROT = 1e12, 1e3, 1e2  # N/m (N m/rad for bearing rotations)
 LENGTH, GAP = 2.0, 1e-3  # m: tube length, connector length

@@ -20,7 +20,7 @@ from roundoff import EPS, scaled_condition
 
 import femmech as fm
 from femmech.analysis.modes import superelement_modes
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 
 E, NU, RHO = 210e9, 0.3, 7850.0
 PLATE = fm.Material(E=E, nu=NU, rho=RHO, name="steel")

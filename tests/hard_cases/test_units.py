@@ -34,7 +34,7 @@ from femmech.mechanisms import (
     position_function,
     rheolinear,
 )
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 
 UNITS = {"m-kg-s": (1.0, 1.0), "mm-t-s": (1e3, 1e-3)}  # (length, mass) per SI unit
 

@@ -22,7 +22,7 @@ from femmech.analysis.reference import full_modes
 from femmech.analysis.sweep import parameter_sweep, sweep
 from femmech.coupling import Attachment, Mount, couple
 from femmech.mechanisms import Damper, Load, Mechanism, PointMass, Spring, rheolinear
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 
 MASS, K1, K2 = 1.0, 4e4, 6e4  # kg, N/m
 P_CRIT = (K2 - K1) / 2  # N/m: flutter onset on a rigid base

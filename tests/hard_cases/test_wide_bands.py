@@ -22,7 +22,7 @@ from numpy.testing import assert_allclose
 import femmech as fm
 from femmech.analysis.modes import superelement_modes
 from femmech.fe import sections
-from femmech.reduction.reduce import craig_bampton
+from femmech.reduction.component_modes import craig_bampton
 
 LENGTH = 10.0
 SHAFT = sections.circle(0.05)

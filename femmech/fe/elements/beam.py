@@ -13,6 +13,8 @@ mass (translational ρA and rotary ρI parts) is integrated from the same shape 
 by 4-point Gauss quadrature, exact for these polynomials (degree <= 6). ``Φ = 0``
 (shear-rigid) is the Euler-Bernoulli element with cubic Hermite interpolation. Axial
 and torsional fields are linear; torsional inertia is ``ρ I_p``.
+
+Stage 2 (fe): imports nothing of femmech; arrays in, element matrices out.
 """
 
 from __future__ import annotations

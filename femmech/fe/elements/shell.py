@@ -64,11 +64,15 @@ at ``±z₀`` from it. The projected nodes are tied to the real nodes by rigid o
 Finite Elements: Their Design and Performance, 1994), so that rigid-body motions of the
 real nodes give zero strain energy. Warping makes the element less accurate; keep ``z₀``
 small compared to the element size.
+
+Stage 2 (fe): imports nothing of femmech; arrays in, element matrices out.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from femmech.fe.elements.registry import ElementType, register
 
 SHEAR_FACTOR = 5.0 / 6.0
 DRILLING = 1e-2
@@ -402,3 +406,7 @@ def _to_global(R, A, T=None):
     if T is not None:
         Q = T @ Q
     return np.swapaxes(Q, 1, 2) @ A @ Q
+
+
+register(ElementType("triangle", "shell", shell_matrices))
+register(ElementType("quad", "shell", shell_matrices))

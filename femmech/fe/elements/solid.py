@@ -33,6 +33,8 @@ quadratic ones for bending-dominated parts.
 
 DOFs: ``ux, uy, uz`` per node, node-major (``3 node_local + component``);
 :func:`assemble_solid` places them at femmech's ``6 node + component``.
+
+Stage 2 (fe): uses only fe.assembly and fe.dofs.
 """
 
 from __future__ import annotations
@@ -44,6 +46,7 @@ from skfem.quadrature import get_quadrature
 
 from femmech.fe.assembly import assemble
 from femmech.fe.dofs import DOF_PER_NODE
+from femmech.fe.elements.registry import ElementType, register
 
 _HEX_VERTICES = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],
                           [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], dtype=float)
@@ -223,3 +226,7 @@ def _shift_index(message: str, kind: str, offset: int) -> str:
         return message
     number, _, rest = message[len(head):].partition(" ")
     return f"{head}{int(number) + offset} {rest}"
+
+
+for _kind in SOLID_TYPES:
+    register(ElementType(_kind, "solid", assemble_solid))
