@@ -1,42 +1,44 @@
-"""Mobile crane of seed 5.2.3.1: the luffing cylinder is braked when the limiter trips.
+"""Mobile crane: the luffing cylinder is braked when the load-moment limiter trips.
 
 Physics
 -------
 A rigid chassis (mass m2 in kg, inertia J_S2 in kg·m²) rides on two tyre springs (c in
 N/m at the front and rear axles, distances l1, l2 in m from the chassis CG), carries a
 luffing boom (m3, J_S3) moved by a hydraulic cylinder of length q4 = s4 (m), and the load
-m5 hangs from the boom tip on a rope of length r_S5 (m) as a pendulum. Coordinates
-(seed 5.2.3.1, errata §A): q1 vertical chassis displacement (m), q2 chassis rotation
-(rad), q3 = φ5 space-fixed pendulum angle (rad), q4 the cylinder length, prescribed.
+m5 hangs from the boom tip on a rope of length r_S5 (m) as a pendulum. Coordinates: q1
+vertical chassis displacement (m), q2 chassis rotation (rad), q3 = φ5 space-fixed
+pendulum angle (rad), q4 the cylinder length, prescribed.
 
-The cylinder length q4(t) is a kinematic drive; the 2nd-kind equations (seed eqs.
-14–16, with the corrected velocity terms of errata 25 and the gravity factor of errata
-24) give q1'', q2'', q3'', and eq. 17 gives the cylinder force Q4 (N) that enforces
-q4(t). ``femmech.mechanisms.second_kind(mobile_crane(), ...)`` derives both from the
-energies of errata §A (geometry with errata 22, 23). The axle (tyre spring) forces are
-eq. 18, F_v = c (q1 − l1 q2) (front), F_h = c (q1 + l2 q2) (rear), positive in
-tension: in the static rest they are negative and carry the weight,
-F_v + F_h = −(m2 + m3 + m5) g (the potential of eq. 13 measures q1 from unloaded springs).
+The cylinder length q4(t) is a kinematic drive; the 2nd-kind equations give q1'', q2'',
+q3'' and the cylinder force Q4 (N) that enforces q4(t).
+``femmech.mechanisms.second_kind(mobile_crane(), ...)`` derives both from the energies.
+The axle (tyre spring) forces are F_v = c (q1 − l1 q2) (front), F_h = c (q1 + l2 q2)
+(rear), positive in tension: in the static rest they are negative and carry the weight,
+F_v + F_h = −(m2 + m3 + m5) g (the potential measures q1 from unloaded springs).
 
-The load case (summary §4, "purpose"): the cylinder retracts (the boom lowers and the
-outreach grows), so the static cylinder force Q4 grows; the load-moment limiter (a
-pressure cell) trips when Q4 reaches ``limit`` and the cylinder is braked to rest. The
-inertia forces of this braking raise Q4 above its quasi-static value and set the load
-swinging. The run:
+The load case: the cylinder retracts (the boom lowers and the outreach grows), so the
+static cylinder force Q4 grows; the load-moment limiter (a pressure cell) trips when Q4
+reaches ``LIMIT`` and the cylinder is braked to rest. The inertia forces of this braking
+raise Q4 above its quasi-static value and set the load swinging. The run
+(:func:`femmech.analysis.drive_events.trip_and_brake`):
 
-1. static rest at q4 = ``q4_start`` (W_pot,j = 0, j = 1..3, by Newton's method);
-2. cylinder speed ramped from 0 to −``speed`` with the cycloidal
+1. static rest at q4 = ``Q4_START`` by Newton's method;
+2. cylinder speed ramped from 0 to −``SPEED`` with the cycloidal
    :class:`~femmech.analysis.response.SpeedRamp` over two pendulum periods
    T = 2π √(r_S5 / g): the spectrum of the ramp's acceleration pulse vanishes at the
    pendulum frequency, so a linear pendulum is left without residual swing;
-3. constant speed until Q4 = ``limit`` (a ``solve_ivp`` event);
-4. cycloidal braking to rest within ``brake_time`` (s), then ``t_after`` (s) at rest.
+3. constant speed until Q4 = ``LIMIT`` (a terminal event of the integrator), at the
+   latest when q4 reaches ``Q4_END`` (the cylinder triangle stays open);
+4. cycloidal braking to rest within each braking time (s), then two pendulum periods at
+   rest.
 
 Integrator: ``scipy.integrate.solve_ivp`` (DOP853) on (q1, q2, q3, q1', q2', q3').
 Units SI throughout. Parameters are the illustrative ``mobile_crane_parameters()`` (no
-damping in the chapter's model, so the swing and the chassis bounce do not decay).
+damping in the chapter's model, so the swing and the chassis bounce do not decay). The
+scene ``examples/crane_braking.toml`` runs the same load case through ``femmech run``.
 
-Sources: seed chapter 5.2.3.1 eqs. 1–18 (summary-en.md §4) with errata items 22–25 and §A.
+Source: the textbook chapter's section 5.2.3.1, eqs. 1–18 (summary-en.md §4), corrected
+per errata items 22–25 and §A.
 
 Run ``python examples/crane_braking.py --out DIR`` to write ``crane_braking.png`` and
 ``crane_braking.csv``.
@@ -50,18 +52,24 @@ from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
-from femmech.analysis.response import SpeedRamp
+from femmech.analysis.drive_events import (
+    spring_forces,
+    static_drive_forces,
+    trip_and_brake,
+)
+from femmech.analysis.drive_events import static_rest as rest_of
 from femmech.mechanisms import mobile_crane, mobile_crane_parameters, second_kind
 
 PARAMS = mobile_crane_parameters()
 Q4_START = 4.7  # m, Q4 ≈ 0.05 MN: the limit is reached after the start-up ramp
+Q4_END = PARAMS["r34"] - PARAMS["r24"] + 0.1  # m, shortest length used (triangle open)
 SPEED = 0.1  # m/s, cylinder retraction speed
 LIMIT = 300e3  # N, limiter force (reached near q4 = 3.9 m)
 BRAKE_TIMES = (0.2, 0.5, 1.0)  # s
 RTOL, ATOL = 1e-10, 1e-12
 MAX_STEP = 0.05  # s, a tenth of the chassis bounce period (about 0.6 s)
+SAMPLES = 1500  # output samples per phase (approach; braking and run-on)
 
 
 @lru_cache(maxsize=1)
@@ -75,26 +83,23 @@ def pendulum_period(params=PARAMS) -> float:
     return 2 * np.pi * np.sqrt(params["rS5"] / params["g"])
 
 
-def static_rest(q4: float, tol: float = 1e-13) -> np.ndarray:
-    """Static rest (q1, q2, q3, q4) at cylinder length q4 (m): W_pot,j = 0 for j = 1..3.
-
-    Newton's method with the potential stiffness W_pot,jk; converges from q = 0 in a few
-    steps (the potential is quadratic in q1 and nearly so in q2, q3).
-    """
-    m = model()
-    q = np.array([0.0, 0.0, 0.0, q4])
-    for _ in range(50):
-        g = m.gradient(q)[:3]
-        dq = np.linalg.solve(m.stiffness(q)[:3, :3], g)
-        q[:3] -= dq
-        if np.abs(dq).max() < tol:
-            return q
-    raise RuntimeError(f"static rest at q4 = {q4} m did not converge")
+def static_rest(q4: float) -> np.ndarray:
+    """Static rest (q1, q2, q3, q4) at cylinder length q4 (m): W_pot,j = 0 for j = 1..3."""
+    return rest_of(model(), [q4])
 
 
 def static_force(q4: float) -> float:
     """Quasi-static cylinder force Q4 = W_pot,4 at the static rest for q4 (m), N."""
-    return float(model().gradient(static_rest(q4))[3])
+    return float(static_drive_forces(model(), static_rest(q4))[0])
+
+
+@lru_cache(maxsize=2)
+def load_case(verify: bool = False):
+    """The limiter load case for all ``BRAKE_TIMES`` (a ``TripAndBrake``)."""
+    T = pendulum_period()
+    return trip_and_brake(model(), "q4", Q4_START, -SPEED, 2 * T, LIMIT, BRAKE_TIMES, 2 * T,
+                          end=Q4_END, samples=SAMPLES, rtol=RTOL, atol=ATOL,
+                          max_step=MAX_STEP, verify=verify)
 
 
 @dataclass(frozen=True)
@@ -108,13 +113,13 @@ class CraneRun:
     q, qd : ndarray (n_t, 4)
         Coordinates q1 (m), q2 (rad), q3 (rad), q4 (m) and their rates.
     Q4 : ndarray (n_t,)
-        Cylinder force (eq. 17), N.
+        Cylinder force, N.
     F_v, F_h : ndarray (n_t,)
-        Front and rear axle forces (eq. 18), N, tension positive.
+        Front and rear axle forces, N, tension positive.
     t_trip, t_stop : float
         Limiter trip time and end of braking, s.
     brake_time : float
-        Braking time, s (``inf`` for a run without braking).
+        Braking time, s.
     """
 
     t: np.ndarray
@@ -128,97 +133,14 @@ class CraneRun:
     brake_time: float
 
 
-def _rhs(law):
-    m = model()
-
-    def f(t, y):
-        q4, v4, a4 = (float(x[0]) for x in law(np.array([t])))
-        acc = m.accelerations(np.r_[y[:3], q4], np.r_[y[3:], v4], [a4])
-        return np.r_[y[3:], acc.qdd[:3]]
-    return f
-
-
-def _drive_force(law, t, y) -> np.ndarray:
-    q4, v4, a4 = law(np.atleast_1d(t))
-    y = np.atleast_2d(y)
-    acc = model().accelerations(np.column_stack([y[:, :3], q4]),
-                                np.column_stack([y[:, 3:], v4]), a4[:, None])
-    return acc.drive_forces[:, 0]
-
-
-def _segment(law, t_span, y0, n, events=None):
-    sol = solve_ivp(_rhs(law), t_span, y0, method="DOP853", rtol=RTOL, atol=ATOL,
-                    dense_output=True, events=events, max_step=MAX_STEP)
-    if sol.status < 0:
-        raise RuntimeError(f"solve_ivp failed on {t_span}: {sol.message}")
-    t_end = sol.t_events[0][0] if events is not None and sol.t_events[0].size else sol.t[-1]
-    t = np.linspace(t_span[0], t_end, n)
-    return t, sol.sol(t).T, t_end
-
-
-@lru_cache(maxsize=4)
-def approach(q4_start: float = Q4_START, speed: float = SPEED, limit: float = LIMIT,
-             n: int = 1500):
-    """Start-up ramp and constant speed until Q4 = ``limit``: (law, t, y (n, 6), t_trip)."""
-    T = pendulum_period()
-    law = SpeedRamp(0.0, -speed, 2 * T, phi0=q4_start)
-    y0 = np.r_[static_rest(q4_start)[:3], 0.0, 0.0, 0.0]
-
-    def trip(t, y):
-        return _drive_force(law, t, y)[0] - limit
-    trip.terminal, trip.direction = True, 1.0
-    p = PARAMS  # q4 > r34 − r24 keeps the cylinder triangle open (arccos defined)
-    t_max = T + (q4_start - (p["r34"] - p["r24"]) - 0.1) / speed
-    t, y, t_trip = _segment(law, (0.0, t_max), y0, n, events=trip)
-    if t_trip >= t_max:
-        raise RuntimeError(f"the limiter force {limit} N is not reached")
-    return law, t, y, t_trip
-
-
-def _history(parts, brake_time, t_trip, t_stop) -> CraneRun:
-    p = PARAMS
-    t = np.concatenate([np.delete(ti, -1) if k < len(parts) - 1 else ti
-                        for k, (_, ti, _) in enumerate(parts)])
-    rows = [(law, ti, yi) if k == len(parts) - 1 else (law, ti[:-1], yi[:-1])
-            for k, (law, ti, yi) in enumerate(parts)]
-    y = np.vstack([yi for _, _, yi in rows])
-    drive = np.vstack([np.column_stack(law(ti)) for law, ti, _ in rows])
-    Q4 = np.concatenate([_drive_force(law, ti, yi) for law, ti, yi in rows])
-    q = np.column_stack([y[:, :3], drive[:, 0]])
-    qd = np.column_stack([y[:, 3:], drive[:, 1]])
-    F_v = p["c"] * (q[:, 0] - p["l1"] * q[:, 1])
-    F_h = p["c"] * (q[:, 0] + p["l2"] * q[:, 1])
-    return CraneRun(t, q, qd, Q4, F_v, F_h, t_trip, t_stop, brake_time)
-
-
-def simulate(brake_time: float | None, t_after: float | None = None, n: int = 1500,
-             **approach_args) -> CraneRun:
-    """Run the load case; ``brake_time`` None runs on at constant speed (no braking).
-
-    Parameters
-    ----------
-    brake_time : float or None
-        Duration of the cycloidal deceleration from −speed to rest, s.
-    t_after : float, optional
-        Time simulated after the end of braking, s; default two pendulum periods.
-    n : int
-        Samples per segment.
-    **approach_args
-        ``q4_start`` (m), ``speed`` (m/s), ``limit`` (N) of :func:`approach`.
-    """
-    law, t0, y0, t_trip = approach(**approach_args, n=n)
-    speed = approach_args.get("speed", SPEED)
-    t_after = 2 * pendulum_period() if t_after is None else t_after
-    q4_trip = float(law(np.array([t_trip]))[0][0])
-    if brake_time is None:
-        brake, t_stop, tb = law, t_trip + t_after, np.inf
-    else:
-        brake = SpeedRamp(-speed, 0.0, brake_time, t_start=t_trip,
-                          phi0=q4_trip + speed * t_trip)
-        t_stop, tb = t_trip + brake_time, brake_time
-    t1, y1, _ = _segment(brake, (t_trip, t_stop + (0.0 if brake_time is None else t_after)),
-                         y0[-1], n)
-    return _history([(law, t0, y0), (brake, t1, y1)], tb, t_trip, t_stop)
+def simulate(brake_time: float) -> CraneRun:
+    """The run with braking time ``brake_time`` (one of ``BRAKE_TIMES``), s."""
+    case = load_case()
+    run = next(r for r in case.runs if r.brake_time == brake_time)
+    h = run.history
+    F_v, F_h = spring_forces(model(), h.q).T  # the tyre springs: front, rear axle
+    return CraneRun(h.t, h.q, h.qd, h.drive_forces[:, 0], F_v, F_h, case.t_trip, run.t_stop,
+                    brake_time)
 
 
 def plot(runs: dict[float, CraneRun], filename) -> Path:
@@ -250,7 +172,7 @@ def plot(runs: dict[float, CraneRun], filename) -> Path:
     axes[2].set_xlabel("time (s)")
     axes[0].legend(fontsize=8)
     axes[1].legend(fontsize=7, ncol=3)
-    axes[0].set_title("Mobile crane (seed 5.2.3.1): cylinder braked by the load-moment limiter")
+    axes[0].set_title("Mobile crane: luffing cylinder braked by the load-moment limiter")
     fig.tight_layout()
     with atomic_path(filename) as tmp:
         fig.savefig(tmp, format="png", dpi=110)

@@ -15,7 +15,10 @@ the FE ones (Rayleigh's principle) and close to them while the frame is much sti
 than the mounts.
 
 Outputs (in ``--out``, default ``out/frame_modes``): ``frequencies.txt``,
-``frequencies.csv``, ``modes.vtu`` (open in ParaView) and ``mode_01.png`` ...
+``frequencies.csv``, ``modes.vtu`` (all modes in one file), ``modes.pvd`` with
+``modes_steps/`` (the modes as a series: ParaView's time control steps through them) and
+``mode_01.png`` ... and ``mode_07.gif`` (the first bending mode swinging through a
+period)
 
 Run: ``python examples/frame_modes.py --out out/frame_modes``
 """
@@ -31,6 +34,8 @@ import femmech as fm
 from femmech.analysis.modes import rigid_body_frequencies
 from femmech.fe import sections
 from femmech.output import export_modes_vtu, frequency_table, plot_modes, write_frequency_csv
+from femmech.output.animate import animate_mode
+from femmech.output.series import write_mode_series
 
 MESH = Path(__file__).resolve().parent.parent / "meshes" / "machine_frame.msh"
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")
@@ -68,11 +73,14 @@ def main(out_dir="out/frame_modes", n_modes: int = 12) -> dict:
     (out / "frequencies.txt").write_text(table + "\n")
     write_frequency_csv(result, out / "frequencies.csv")
     export_modes_vtu(model, result, out / "modes.vtu")
+    write_mode_series(model, result, out / "modes.pvd")
+    animate_mode(model, result, 6, out / "mode_07.gif")  # the first bending mode, moving
     images = plot_modes(model, result, out, prefix="mode")
     print(f"machine frame: {model.mesh.n_nodes} nodes, {model.n_free} free DOFs,"
           f" mass {model.total_mass():.1f} kg, solver {result.method}")
     print(table)
-    print(f"wrote {len(images)} images, frequencies.txt/.csv and modes.vtu to {out}")
+    print(f"wrote {len(images)} images, frequencies.txt/.csv, modes.vtu, modes.pvd and mode_07.gif"
+          f" to {out}")
     return {
         "freq_hz": result.freq_hz,
         "rigid_body_estimate_hz": rigid_body_frequencies(model),

@@ -1,4 +1,4 @@
-"""Quasi-eigenfrequencies of the processing machine of seed 5.2.3.2 over one revolution.
+"""Quasi-eigenfrequencies of the cam-driven processing machine over one revolution.
 
 Physics
 -------
@@ -8,7 +8,7 @@ masses m1, m2 (kg) through follower elasticities c3, c4 (N/m) against return spr
 c7 (N/m). The input angle q1 = φ is prescribed (kinematic drive, 4 DOF q2…q5). At each
 frozen drive angle the undamped eigenproblem C(φ, Ω) v = ω² M(φ) v is solved:
 
-* M(φ) is eq. 20 of seed 5.2.3.2;
+* M(φ) is eq. 20 of the chapter's section 5.2.3.2;
 * C(φ, 0) is the potential stiffness, eq. 21 (errata 29);
 * C(φ, Ω) adds the kinematic terms Ω² K_Ω(φ) of errata item 30 (unsymmetric).
 
@@ -18,7 +18,8 @@ decouple and the frequencies have closed forms: the followers √((c3 + c6)/m1)/
 the two-inertia shaft with M = [[J1 + J2, J2], [J2, J2]], C = diag(cT1, cT2). ``main``
 returns these with the computed values so a test can compare them.
 
-Sources: seed chapter 5.2.3.2 eqs. 20–21, errata items 29–30; cam laws from Norton,
+Sources: textbook chapter 5, "Schwingungsmodelle mit mehreren Freiheitsgraden", section
+5.2.3.2, eqs. 20–21, errata items 29–30; cam laws from Norton,
 *Cam Design and Manufacturing Handbook* (2009), ch. 3. Parameter values are illustrative
 (``processing_machine_parameters``); the drive speed is 1200 rpm.
 """
@@ -34,7 +35,8 @@ from femmech.mechanisms import (
     processing_machine_parameters,
     rheolinear,
 )
-from femmech.mechanisms.quasi_modes import plot_quasi_frequencies, quasi_modes
+from femmech.mechanisms.quasi_modes import quasi_modes
+from femmech.output.sweeps import plot_quasi_frequencies
 
 RPM = 1200.0
 
@@ -70,7 +72,8 @@ def main(out_dir="out") -> dict:
     plot = plot_quasi_frequencies(
         {"static C": static, f"C at {RPM:.0f} rpm": at_speed},
         Path(out_dir) / "quasi_frequencies.png",
-        title="Processing machine (seed 5.2.3.2), kinematic drive: quasi-eigenfrequencies")
+        title="Cam-driven processing machine, drive at prescribed speed: quasi-eigenfrequencies",
+        speed=Omega)  # its harmonics k·n (k <= 6) in the plotted range: 4·n, 5·n, 6·n
     shift = np.nanmax(np.abs(at_speed.freq_hz - static.freq_hz) / static.freq_hz)
     return {"freq_min_hz": static.freq_hz.min(axis=0), "freq_max_hz": static.freq_hz.max(axis=0),
             "dwell_hz": dwell.freq_hz[0], "dwell_reference_hz": dwell_reference(p),

@@ -6,7 +6,8 @@ A C-frame press (steel box sections, in the x-z plane): a column (x = 0, 2 m hig
 clamped at its foot), a crown (upper arm, 0.6 m deep) carrying the crank housing at its
 front end, a gib hanging 0.4 m down from the crown front that guides the ram, and a bed
 (lower arm at z = 0.6 m) whose front rests on a leg (clamped foot). The press mechanism
-is a :func:`femmech.mechanisms.mounted.slider_crank` (Table 5.1 case 1 of seed 5.2.2 with
+is a :func:`femmech.mechanisms.mounted.slider_crank` (case 1 of Table 5.1 in section 5.2.2
+of the chapter, with
 U = SliderCrank(r, l): crank radius r = 50 mm, i.e. a 100 mm stroke, rod l = 350 mm, no
 offset) whose slider axis points down (-z):
 
@@ -25,11 +26,12 @@ crank torsion then decouples from ram and frame, and its frequency is exactly
 √(c1/J1)/(2π) = 130 Hz whatever the frame. The sweep includes both dead centres.
 
 The frame is reduced by Craig-Bampton (residual vectors) with the three attachment DOFs
-as interface; the coupled system (seed 5.2.2 eq. 9, Ω = 0: symmetric potential C) is
+as interface; the coupled system (section 5.2.2 eq. 9, Ω = 0: symmetric potential C) is
 swept over one revolution and compared with the unreduced coupled model, and, with the
 mechanism attached at a clamped node (rigid frame), with Table 5.1 case 1 alone.
 
-Sources: seed chapter 5.2.2 Table 5.1 case 1 and eq. 9-10, errata §A; slider-crank
+Sources: textbook chapter 5, "Schwingungsmodelle mit mehreren Freiheitsgraden", section
+5.2.2, Table 5.1 case 1 and eq. 9-10, errata §A; slider-crank
 kinematics, Dresig & Holzweißig, *Maschinendynamik*, ch. 2; C-frame press layout,
 Schuler GmbH, *Metal Forming Handbook*, Springer (1998), on press types. Parameters
 are illustrative (SI).
@@ -61,7 +63,6 @@ from femmech.coupling import Attachment, Mount, couple
 from femmech.fe import sections
 from femmech.mechanisms import (
     SliderCrank,
-    plot_quasi_frequencies,
     quasi_modes,
     rheolinear,
     second_kind,
@@ -70,7 +71,7 @@ from femmech.mechanisms import (
 from femmech.mechanisms.mounted import slider_crank
 from femmech.output.histories import plot_orbit, plot_time_histories, write_history_csv
 from femmech.output.stability_charts import plot_speed_study
-from femmech.output.sweeps import write_sweep_csv
+from femmech.output.sweeps import plot_quasi_frequencies, write_sweep_csv
 from femmech.reduction import craig_bampton
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")
@@ -171,7 +172,7 @@ def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int = 70
 
     Steady state (shooting, Richardson-extrapolated; ρ∞ = 1 so that the rigid-attachment
     forces are those of the discrete solution): ram deflection, crank twist, crank-bearing
-    and guide forces on the frame, drive torque (the crank's drive row, seed 5.2.2 eq. 2
+    and guide forces on the frame, drive torque (the crank's drive row, section 5.2.2 eq. 2
     for j = n+1), the column-foot bending moment (elastic section force) and the orbit of
     the crank bearing. Stability
     (:func:`femmech.analysis.stability.speed_study`): growth rate ln(max|μ|)/T over
@@ -202,7 +203,8 @@ def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int = 70
         "drive torque (kN m)": {"crank drive row": 1e-3 * torque},
         "column foot bending\nmoment (kN m)": {"M_y (elastic)": 1e-3 * foot_My}},
         out / "steady_state.png", xlabel="crank angle φ (deg), BDC at 0°",
-        title=f"Press at {spm:.0f} strokes/min: periodic steady state")
+        title=f"Press at {spm:.0f} strokes/min: periodic steady state",
+        angle_deg=True)
     plot_orbit(1e6 * bearing[:, 0], 1e6 * bearing[:, 1], out / "crank_bearing_orbit.png",
                "crank bearing u_x (µm)", "crank bearing u_z (µm)",
                f"Crank bearing over one stroke at {spm:.0f} strokes/min")

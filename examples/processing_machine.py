@@ -1,8 +1,8 @@
-"""Processing machine of seed 5.2.3.2 with an FE drive shaft, mounted in a welded frame.
+"""Cam-driven processing machine with an FE drive shaft, mounted in a welded frame.
 
 Physics
 -------
-The chapter's machine (seed 5.2.3.2, errata §A): a drive shaft carries the discs J0
+The chapter's machine (section 5.2.3.2, errata §A): a drive shaft carries the discs J0
 (drive end), J1 and J2 with torsional stiffnesses cT1, cT2 between them; two cam
 mechanisms U1 (on J1) and U2 (on J2) move the follower masses m1, m2 through the
 follower elasticities c3, c4 against the return springs c6, c7. Here
@@ -25,7 +25,7 @@ follower elasticities c3, c4 against the return springs c6, c7. Here
 Parameters: ``processing_machine_parameters()`` (SI), the cams of
 ``examples/mechanism_quasi_modes.py`` (modified-sine and 3-4-5 rise/return, 50/40 mm).
 Shaft and frame form one FE model, reduced by Craig-Bampton (residual vectors) with the
-six attachment DOFs as interface; the coupled quasi-eigenfrequencies (seed 5.2.2 eq. 9,
+six attachment DOFs as interface; the coupled quasi-eigenfrequencies (section 5.2.2 eq. 9,
 Ω = 0: symmetric potential C) are swept over one revolution and compared with
 
 1. the chapter's mechanism-only model (rigid frame: bearings as supports, return springs
@@ -33,7 +33,8 @@ six attachment DOFs as interface; the coupled quasi-eigenfrequencies (seed 5.2.2
    inertia, as in the lumped model), see :func:`rigid_check`;
 2. the unreduced coupled model at several angles (:func:`compare`).
 
-Sources: seed chapter 5.2.3.2 eqs. 11, 16, 20, 21 with errata 29-30; Norton, *Cam Design
+Sources: textbook chapter 5, "Schwingungsmodelle mit mehreren Freiheitsgraden", section
+5.2.3.2, eqs. 11, 16, 20, 21 with errata 29-30; Norton, *Cam Design
 and Manufacturing Handbook* (2009), ch. 3 (cam laws); torsion of a circular shaft
 ``c_T = G I_p / L`` (e.g. Gere & Goodno, *Mechanics of Materials*, §3.3).
 
@@ -63,7 +64,6 @@ from femmech.coupling import Attachment, Mount, couple
 from femmech.fe import sections
 from femmech.fe.generators import grid_frame
 from femmech.mechanisms import (
-    plot_quasi_frequencies,
     processing_machine,
     processing_machine_cams,
     processing_machine_parameters,
@@ -74,7 +74,7 @@ from femmech.mechanisms import (
 from femmech.mechanisms.mounted import cam_follower
 from femmech.output.histories import plot_orbit, plot_time_histories, write_history_csv
 from femmech.output.stability_charts import plot_speed_study
-from femmech.output.sweeps import write_sweep_csv
+from femmech.output.sweeps import plot_quasi_frequencies, write_sweep_csv
 from femmech.reduction import craig_bampton
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")
@@ -245,7 +245,8 @@ def dynamics(out_dir="out/processing_machine", rpm: float = OPERATING_RPM,
         "torque (N m)": {"motor (drive-end reaction)": motor,
                          "Σ cam drive rows (rigid shaft)": rows}},
         out / "steady_state.png", xlabel="drive angle φ (deg)",
-        title=f"Processing machine at {rpm:.0f} rpm: periodic steady state")
+        title=f"Processing machine at {rpm:.0f} rpm: periodic steady state",
+        angle_deg=True)
     plot_orbit(1e6 * centre[:, 0], 1e6 * centre[:, 1], out / "shaft_orbit_cam1.png",
                "shaft centre at cam 1, u_y (µm)", "u_z (µm)",
                f"Shaft at cam 1 over one revolution at {rpm:.0f} rpm")
@@ -279,10 +280,10 @@ def main(out_dir="out/processing_machine", n_angles: int = 181, n_modes: int = 9
     rigid_error, rigid, alone = rigid_check(phi)
     plot_quasi_frequencies({"frame + FE shaft (reduced)": result},
                            out / "quasi_frequencies.png",
-                           title="Processing machine (seed 5.2.3.2) on a frame")
+                           title="Cam-driven processing machine on a frame")
     plot_quasi_frequencies({"rigid frame, massless FE shaft": rigid, "chapter model": alone},
                            out / "rigid_frame_check.png",
-                           title="Rigid frame: coupled vs mechanism-only (seed 5.2.3.2)")
+                           title="Rigid frame: coupled model vs mechanism alone")
     write_sweep_csv(result, out / "quasi_frequencies.csv")
     (out / "reduced_vs_full.txt").write_text(comparison.table() + "\n")
     print(f"FE model {model.n_free} free DOFs, superelement {se.n_reduced}, coupled"

@@ -1,6 +1,7 @@
 """Textile-machine main shaft with N identical cam mechanisms, mounted in a frame.
 
-Physics (seed chapter 5.1, figure 5.1: chains of identical mechanisms on one main shaft):
+Physics (textbook chapter 5, "Schwingungsmodelle mit mehreren Freiheitsgraden", section 5.1,
+figure 5.1: chains of identical mechanisms on one main shaft):
 a steel main shaft (d = 60 mm) along x carries N cams at 0.1 m spacing. It runs in
 bearings (radial stiffness 2e8 N/m) on pedestals of a welded base beam (HEB-like
 I-section) that stands on four feet. The drive end of the shaft follows the programmed
@@ -52,7 +53,6 @@ from femmech.mechanisms import (
     PointMass,
     RotaryInertia,
     Spring,
-    plot_quasi_frequencies,
     polynomial_345,
     position_function,
     rheolinear,
@@ -61,7 +61,12 @@ from femmech.mechanisms import (
 from femmech.output.histories import plot_orbit, plot_time_histories, write_history_csv
 from femmech.output.machine import plot_coupled_mode
 from femmech.output.stability_charts import plot_speed_study
-from femmech.output.sweeps import plot_mac, write_sweep_csv, write_sweep_json
+from femmech.output.sweeps import (
+    plot_mac,
+    plot_quasi_frequencies,
+    write_sweep_csv,
+    write_sweep_json,
+)
 from femmech.reduction import craig_bampton
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")
@@ -190,7 +195,8 @@ def dynamics(out_dir="out/textile", n_cams: int = 10, rpm: float = OPERATING_RPM
         "torque (N m)": {"motor (drive-end reaction)": motor,
                          "Σ cam drive rows (rigid shaft)": rows}},
         out / "steady_state.png", xlabel="main-shaft angle φ (deg)",
-        title=f"{n_cams} cams at {rpm:.0f} rpm: periodic steady state")
+        title=f"{n_cams} cams at {rpm:.0f} rpm: periodic steady state",
+        angle_deg=True)
     plot_orbit(1e6 * orbit[:, 0], 1e6 * orbit[:, 1], out / "shaft_orbit.png",
                f"shaft at cam {n_cams // 2 + 1}, u_y (µm)", "u_z (µm)",
                f"Main shaft over one revolution at {rpm:.0f} rpm")
@@ -223,7 +229,7 @@ def main(out_dir="out/textile", n_cams: int = 10, n_angles: int = 181,
     t_sweep = time.perf_counter() - start
     a = n_angles // 8  # 45°, in the cams' rise
     plot_coupled_mode(model, reduced, result.vectors[a, :, 0], result.freq_hz[a, 0],
-                      out / "coupled_mode_1.png", angle=phi[a])
+                      out / "coupled_mode_1.png", angle=phi[a], speed=0.0, mode_number=1)
     check = phi[[0, n_angles // 8, n_angles // 4, n_angles // 2]]
     comparison = compare_coupled(reduced, full, check, n_modes)
     errors, macs = np.abs(comparison.rel_error), comparison.diag_mac

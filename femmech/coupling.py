@@ -33,6 +33,7 @@ import scipy.sparse as sp
 
 from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
 from femmech.fe.model import FEModel, node_index
+from femmech.html import html_summary
 from femmech.reduction.substructures import Assembly
 from femmech.reduction.superelement import Superelement
 
@@ -129,6 +130,14 @@ class CoupledSystem:
         return (f"CoupledSystem({self.n} coordinates: {kind} frame with {self.n_frame},"
                 f" {len(self.mounts)} mounted mechanism(s) with {self.n - self.n_frame};"
                 f" {'sparse' if self.is_sparse else 'dense'})")
+
+    def _repr_html_(self) -> str:
+        rows = [(m.name, type(m.model).__name__) for m in self.mounts]
+        facts = [("frame", f"{type(self.frame).__name__}, {self.n_frame} coordinates"),
+                 ("mechanism coordinates", self.n - self.n_frame),
+                 ("matrices", "sparse" if self.is_sparse else "dense")]
+        return html_summary(f"CoupledSystem: {self.n} coordinates", facts,
+                            ("mount", "mechanism model"), rows)
 
     @property
     def n(self) -> int:

@@ -6,8 +6,13 @@ input but failed is a :class:`NumericalError`. Both derive from the builtin clas
 already catches (``ValueError``, ``RuntimeError``). The command line maps them to its
 documented exit codes (:mod:`femmech.cli`).
 
+:func:`did_you_mean` and :func:`name_list` word the messages for a name that does not
+exist (a group of a mesh, a key), so that every stage lists the available names the same way.
+
 Stage 0: imports nothing of femmech; every module may import it.
 """
+
+import difflib
 
 
 class FemmechWarning(UserWarning):
@@ -53,3 +58,36 @@ class CacheWarning(FemmechWarning):
 class ConvergenceWarning(FemmechWarning):
     """A stepped or iterative result missed its tolerance; it is returned marked as
     unconverged (``converged=False``) with its error estimate, never as a plain number."""
+
+
+MAX_LISTED_NAMES = 40
+"""Most names :func:`name_list` spells out (a deck may hold thousands of sets)."""
+
+
+def closest_name(word, names) -> str | None:
+    """The name of ``names`` nearest to ``word``: one that differs only in case, else the
+    closest by :func:`difflib.get_close_matches` (ratio >= 0.6, compared case-blind);
+    None if none is near."""
+    names = [str(n) for n in names]
+    folded = {}
+    for name in names:
+        folded.setdefault(name.casefold(), name)
+    word = str(word).casefold()
+    if word in folded:
+        return folded[word]
+    close = difflib.get_close_matches(word, list(folded), n=1, cutoff=0.6)
+    return folded[close[0]] if close else None
+
+
+def did_you_mean(word, names) -> str:
+    """``"; did you mean 'x'?"`` for the name of ``names`` nearest to ``word``, or ``""``."""
+    near = closest_name(word, names)
+    return f"; did you mean {near!r}?" if near is not None and near != word else ""
+
+
+def name_list(names, limit: int = MAX_LISTED_NAMES) -> str:
+    """``"['a', 'b']"``, sorted; past ``limit`` names ``"['a', ..., 'z'] and 12 more"``."""
+    names = sorted(str(n) for n in names)
+    if len(names) <= limit:
+        return str(names)
+    return f"{names[:limit]} and {len(names) - limit} more"

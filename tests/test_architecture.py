@@ -19,7 +19,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "femmech"
 
 STAGES = {
-    "errors": 0, "version": 0,
+    "errors": 0, "version": 0, "html": 0,
     "solve": 1,
     "fe": 2, "mechanisms": 2,
     "reduction": 3,

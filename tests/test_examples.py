@@ -22,7 +22,41 @@ def _load(name):
 @pytest.fixture(scope="module")
 def frame_run(tmp_path_factory):
     module = _load("frame_modes")
-    return module, module.main(tmp_path_factory.mktemp("frame"))
+    out = tmp_path_factory.mktemp("frame")
+    return module, {**module.main(out), "out": out}
+
+
+def test_frame_example_writes_a_paraview_series(frame_run):
+    """modes.pvd: one step per mode (time = mode number), each a VTU meshio reads, with
+    the displacement of that mode (femmech.output.series)."""
+    import meshio
+
+    from femmech.output.series import read_pvd
+
+    _, result = frame_run
+    steps = read_pvd(result["out"] / "modes.pvd")
+    assert [t for t, _ in steps] == [float(k) for k in range(1, len(result["freq_hz"]) + 1)]
+    for k, (_, vtu) in enumerate(steps):
+        mesh = meshio.read(vtu)
+        assert mesh.point_data["displacement"].shape == (len(mesh.points), 3)
+        assert mesh.field_data["frequency_hz"][0] == result["freq_hz"][k]
+
+
+def test_frame_example_writes_a_mode_animation(frame_run):
+    """mode_07.gif: 24 frames of one period (23 after Pillow merges the two identical
+    frames at a turning point), 800 x 600, looping; the frames differ (the mode moves)."""
+    from PIL import Image
+
+    _, result = frame_run
+    with Image.open(result["out"] / "mode_07.gif") as gif:
+        assert gif.size == (800, 600)
+        assert gif.n_frames >= 20
+        assert gif.info["loop"] == 0
+        frames = []
+        for k in (0, gif.n_frames // 4):
+            gif.seek(k)
+            frames.append(np.asarray(gif.convert("RGB"), dtype=float))
+    assert np.abs(frames[0] - frames[1]).mean() > 1.0  # the shape moved between frames
 
 
 def test_frame_example_mass(frame_run):

@@ -216,15 +216,17 @@ def test_unknown_group_from_file_lists_the_file_groups(tmp_path):
     path = tmp_path / "frame.msh"
     path.write_text(MSH41)
     mesh = fm.read_mesh(path)
-    match = r"unknown group 'Beam'; the mesh has cell sets \['beam', 'post'\]"
+    match = (r"unknown group 'Beam'; the mesh has cell sets \['beam', 'post'\]; did you mean"
+             r" 'beam'\?")
     with pytest.raises(ValueError, match=match):
         fm.build_model(mesh, {"Beam": BEAMS["beam"], "post": BEAMS["post"]})
 
 
-def test_unreadable_file_raises_value_error_naming_the_file(tmp_path):
+def test_unreadable_file_raises_file_format_error_naming_the_file(tmp_path):
     path = tmp_path / "garbage.msh"
     path.write_text("this is not a mesh\n")
-    with pytest.raises(ValueError, match=r"garbage\.msh: meshio could not read the file"):
+    with pytest.raises(fm.FileFormatError, match=r"garbage\.msh: meshio could not read the"
+                                                 " file"):
         fm.read_mesh(path)
 
 

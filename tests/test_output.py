@@ -36,7 +36,24 @@ from femmech.output import (
     plot_modes,
     write_frequency_csv,
 )
+from femmech.output.annotate import (
+    COLOUR_BAR_TITLE,
+    LegendEntry,
+    format_factor,
+    make_layout,
+    panel_image,
+    scale_text,
+)
+from femmech.output.camera import fit_camera, project, screen_axes
+from femmech.output.mode_geometry import (
+    drawn_points,
+    ground_springs,
+    joined_pairs,
+    joint_nodes,
+    model_glyphs,
+)
 from femmech.output.plot import RADIUS_RANGE, SCALE_FRACTION
+from femmech.output.renderer import COLORS, ModeRenderer, scene_legend
 
 IMAGES = Path(__file__).parent / "images"
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
@@ -212,7 +229,7 @@ def test_plot_modes_writes_pngs_of_requested_size(tmp_path):
 
 
 def test_headless_backend_choice(monkeypatch):
-    from femmech.output.plot import _select_headless_backend
+    from femmech.output.renderer import select_headless_backend as _select_headless_backend
 
     monkeypatch.delenv("VTK_DEFAULT_OPENGL_WINDOW", raising=False)
     monkeypatch.setenv("DISPLAY", ":0")
@@ -251,11 +268,12 @@ def test_cantilever_image_matches_reference(tmp_path):
         reference.parent.mkdir(exist_ok=True)
         reference.write_bytes(out.read_bytes())
     error = pv.compare_images(str(out), str(reference), use_vtk=False)
-    # Mean over pixels of the summed |ΔRGB| (0..765), measured against this reference:
-    # a 1 % camera zoom 4.2, a 3 % larger displacement scale 7.0 (the size of shading and
-    # edge differences between OpenGL drivers or VTK versions is below these); the bar
-    # deflecting the other way 14.3, the second bending mode 16.6. The threshold 10
-    # separates the two groups.
+    # Mean over pixels of the summed |ΔRGB| (0..765), measured against this reference
+    # (issue 20 layout: header, panel and triad around the view): a 1 % camera zoom 6.1,
+    # a 3 % larger displacement scale 7.8 (the size of shading and edge differences
+    # between OpenGL drivers or VTK versions is below these); the bar deflecting the
+    # other way 12.6, the second (stiff-plane) bending mode 11.6; re-rendering 0.0. The
+    # threshold 10 separates the two groups.
     assert error < 10.0, f"image differs from {reference}: mean pixel error {error:.2f}"
 
 
@@ -323,3 +341,181 @@ def test_frequency_table_and_csv(tmp_path):
     assert_allclose([float(r["freq_hz"]) for r in rows], result.freq_hz, rtol=0)
     assert [bool(int(r["rigid"])) for r in rows] == result.rigid.tolist()
     assert_allclose([float(r["residual"]) for r in rows], result.residual, rtol=0)
+
+
+# -- issue 20: one scene per model, one camera, annotations ---------------------------------
+
+
+def _decorated_frame():
+    """The 3D frame with every glyph: a support (node 0), a 20 kg mass 0.2 m above node 3
+    on a rigid link, a spring to the ground at node 5, and a spring from node 6 to a
+    coincident node 7 that starts a short beam to node 8."""
+    base = _frame_3d()
+    points = np.vstack([base.mesh.points, base.mesh.points[6], base.mesh.points[6] + [0.3, 0, 0],
+                        base.mesh.points[3] + [0, 0, 0.2]])
+    lines = np.vstack([base.beams.cells, [[7, 8]]])
+    mesh = fm.Mesh.from_lines(points, lines, node_sets={"base": [0]})
+    prop = fm.BeamProperty(sections.rectangle(0.04, 0.02), STEEL)
+    return fm.build_model(mesh, {"all": prop}, supports=[fm.Support("base")],
+                          masses=[fm.PointMass(9, 20.0)],
+                          springs=[fm.Spring(5, None, [1e5] * 3 + [0] * 3),
+                                   fm.Spring(6, 7, [1e7] * 3 + [1e4] * 3)],
+                          rigid_links=[fm.RigidLink(3, [9])])
+
+
+def test_texts_of_the_annotations():
+    # 3 significant digits, no exponent from 0.01 to 99 900 (issue: "2-3 significant digits")
+    assert [format_factor(v) for v in (1234.5, 12.34, 0.04567, 2.0, 99.96, 0.01)] == \
+        ["1230", "12.3", "0.0457", "2", "100", "0.01"]
+    assert format_factor(3.2e6) == "3.2·10⁶"
+    assert format_factor(4.5e-4) == "4.5·10⁻⁴"
+    assert scale_text(4.333) == "deformation ×4.33"
+    assert scale_text(1234.5, 0.12) == ("deformation ×1230 (largest displacement drawn as 12 %"
+                                        " of the model size)")
+    # the colours are |u| relative to the mode's largest |u|: a ratio, said so
+    assert COLOUR_BAR_TITLE == ("displacement", "|u| / max |u|", "(dimensionless)")
+
+
+def test_springs_links_and_legend_of_exactly_the_glyphs_drawn():
+    model = _decorated_frame()
+    links, springs = joined_pairs(model)
+    assert links.tolist() == [[3, 9]]  # no stiffness between them: a constraint
+    assert springs.tolist() == [[6, 7]]  # K couples them, no beam joins them
+    nodes, directions = ground_springs(model)
+    assert nodes.tolist() == [5]
+    assert_allclose(directions, [[0, 0, -1]])  # equal stiffness: drawn downwards
+    glyphs = model_glyphs(model)
+    assert glyphs.supports.tolist() == [0]
+    assert glyphs.masses.tolist() == [9]
+    labels = [e.label for e in scene_legend(glyphs, True, False, True)]
+    assert labels == ["undeformed", "support", "point mass", "rigid link / spider", "spring"]
+    bare, _, _ = _line_model(2)
+    bare_glyphs = model_glyphs(bare)
+    assert [e.label for e in scene_legend(bare_glyphs, True, False, True)] == ["undeformed",
+                                                                              "support"]
+    assert scene_legend(model_glyphs(_free_bar()), True, False, False) == ()
+    # balls only where tubes end or meet at an angle: not at the straight bar's middle
+    # node, not at the frame's node 2 (on a straight run), not at the mass node 9
+    assert joint_nodes(bare).tolist() == [0, 2]
+    assert joint_nodes(model).tolist() == [0, 1, 3, 4, 5, 6, 7, 8]
+
+
+def _free_bar():
+    mesh = fm.Mesh.from_lines([[0, 0, 0], [1, 0, 0]], [[0, 1]])
+    return fm.build_model(mesh, {"all": fm.BeamProperty(sections.circle(0.02), STEEL)})
+
+
+def test_fit_camera_shows_all_points_centred():
+    rng = np.random.default_rng(4)
+    points = rng.standard_normal((200, 3)) * [2.0, 0.5, 1.0] + [10.0, -3.0, 1.0]
+    for view, aspect in (("iso", 4 / 3), ("xz", 1.0), (((0.2, -1, 0.4), (0, 0, 1)), 0.6)):
+        camera = fit_camera(points, view, aspect, margin=0.1)
+        ndc = project(camera, points, aspect)
+        assert np.abs(ndc).max() == pytest.approx(0.9, abs=1e-9)  # tight in one direction
+        tight = int(np.argmax(np.abs(ndc).max(axis=0)))
+        # centred: the extremes of the tight direction sit symmetrically
+        assert ndc[:, tight].max() == pytest.approx(-ndc[:, tight].min(), abs=1e-9)
+    with pytest.raises(ValueError, match="unknown camera 'top'"):
+        fit_camera(points, "top")
+
+
+def test_screen_axes_of_the_named_views():
+    points = np.eye(3)
+    # xy: looking down z, y up; x to the right, z towards the viewer
+    assert_allclose(screen_axes(fit_camera(points, "xy")), [[1, 0, 0], [0, 1, 0], [0, 0, -1]],
+                    atol=1e-12)
+    # xz: looking along +y, z up, x to the right, y into the screen
+    assert_allclose(screen_axes(fit_camera(points, "xz")), [[1, 0, 0], [0, 0, 1], [0, 1, 0]],
+                    atol=1e-12)
+
+
+def test_one_scene_one_camera_for_all_modes(tmp_path, monkeypatch):
+    import femmech.output.plot as plot
+
+    model = _decorated_frame()
+    result = fm.modes(model, n_modes=4)
+    seen, texts = [], []
+    render = ModeRenderer.render
+
+    def spy_render(self, u, scale, decoration=None):
+        image = render(self, u, scale, decoration)
+        seen.append((id(self), [tuple(v) for v in self.plotter.camera_position],
+                     self._lines.points.copy(), u, scale, image.shape))
+        return image
+
+    def spy_compose(view, background, layout, title, lines, k=1):
+        texts.append((title, lines))
+        return compose(view, background, layout, title, lines, k)
+
+    compose = plot.compose
+    monkeypatch.setattr(ModeRenderer, "render", spy_render)
+    monkeypatch.setattr(plot, "compose", spy_compose)
+    plot_modes(model, result, tmp_path, window_size=(320, 240), workers=1)
+    assert len({s[0] for s in seen}) == 1  # one scene for the four images
+    assert all(s[1] == seen[0][1] for s in seen)  # one camera
+    camera = plot.camera_from_position(seen[0][1])
+    height, width = seen[0][5][:2]
+    for _, _, points, u, scale, _ in seen:
+        # the scene's curves are the mode's curves (points replaced per mode)
+        assert_allclose(points, mode_mesh(model, u, scale).points, rtol=0, atol=1e-12)
+        # nothing leaves the frame: every drawn point of every mode projects inside
+        glyphs = model_glyphs(model)
+        ndc = project(camera, drawn_points(model, u, scale, glyphs), width / height)
+        assert np.abs(ndc).max() < 1.0
+    for k, (title, lines) in enumerate(texts):
+        assert title == mode_title(result, k)
+        scale = mode_scale(model, result.shapes[:, k])
+        assert lines[-1] == (scale_text(scale, SCALE_FRACTION), scale_text(scale))
+        assert len(lines) == 2
+        assert lines[0]
+
+
+def test_panel_draws_colour_bar_legend_and_triad():
+    legend = (LegendEntry("point mass", COLORS["mass"], "circle"),
+              LegendEntry("spring", COLORS["spring"], "coil"))
+    layout = make_layout((640, 480), 1, legend)
+    image = panel_image(layout, legend, screen_axes(fit_camera(np.eye(3), "iso")), "viridis", 2)
+    assert image.shape == (480, 640, 3)
+    panel = image[:, -layout.panel:].reshape(-1, 3).astype(int)
+    assert (image[:, :-layout.panel] == 255).all()  # the view area stays free
+
+    def has(color):
+        rgb = np.array([int(color[i:i + 2], 16) for i in (1, 3, 5)])
+        return (np.abs(panel - rgb).sum(axis=1) < 20).any()
+
+    # viridis ends (#fde725, #440154), the glyph colours, the triad's red, green and blue
+    for color in ("#fde725", "#440154", COLORS["mass"], COLORS["spring"], "#d62728",
+                  "#2ca02c", "#1f77b4"):
+        assert has(color), color
+
+
+def test_workers_draw_the_same_images(tmp_path):
+    model = _decorated_frame()
+    result = fm.modes(model, n_modes=2)
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    serial = plot_modes(model, result, tmp_path / "a", window_size=(240, 180), workers=1)
+    pooled = plot_modes(model, result, tmp_path / "b", window_size=(240, 180), workers=2)
+    for a, b in zip(serial, pooled, strict=True):
+        assert a.name == b.name
+        assert np.array_equal(np.asarray(Image.open(a)), np.asarray(Image.open(b)))
+    with pytest.raises(ValueError, match="workers"):
+        plot_modes(model, result, tmp_path, workers=0)
+
+
+def test_explicit_camera_is_used_as_given(tmp_path, monkeypatch):
+    model, _, _ = _line_model(2)
+    result = fm.modes(model, n_modes=1)
+    seen = []
+    render = ModeRenderer.render
+
+    def spy(self, u, scale, decoration=None):
+        seen.append([tuple(v) for v in self.plotter.camera_position])
+        return render(self, u, scale, decoration)
+
+    monkeypatch.setattr(ModeRenderer, "render", spy)
+    position = [(0.5, -3.0, 0.2), (0.5, 0.0, 0.0), (0.0, 0.0, 1.0)]
+    plot_mode(model, result, 0, tmp_path / "a.png", window_size=(200, 150), camera=position)
+    assert_allclose(np.array(seen[0]), np.array(position), atol=1e-12)
+    with pytest.raises(ValueError, match="three 3-vectors"):
+        plot_mode(model, result, 0, tmp_path / "b.png", camera=[(0, 0, 1)])

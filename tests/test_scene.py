@@ -260,7 +260,7 @@ attachments = [{ coordinate = "y_c", node = 4, direction = "uz" }]
     (("mechanisms", "cam", "parameters", "k"), 1.0,
      "[mechanisms.cam] parameters: unknown parameters ['k']"),
     (("mechanisms", "cam", "model"), "crank",
-     "[mechanisms.cam] model: expected one of ['cam_follower', 'processing_machine',"),
+     "[mechanisms.cam] model: expected one of ['cam_follower', 'mobile_crane',"),
     (("mechanisms", "cam", "position_functions", "U", "l"), "10 mm",
      "[mechanisms.cam.position_functions.U] l: expected a coupler longer than r + |e| ="
      " 0.02 m (a fully rotating crank), got 0.01 m"),

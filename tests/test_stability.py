@@ -239,6 +239,15 @@ def test_plot_stability_chart(tmp_path):
     assert not chart.stable.all()  # the principal tongue at ε > 4ζ = 0.04
     out = plot_stability_chart(chart, tmp_path / "chart.png", marks={"2ω₀": 2 * w0})
     assert out.stat().st_size > 5000
+    # read back: the tongue at Ω = 2ω₀ is shaded in the rows ε = 0.1, 0.2, not at ε = 0
+    from femmech.output.stability_charts import stability_figure
+
+    ax = stability_figure(chart, marks={"2ω₀": 2 * w0}).axes[0]
+    for eps, tongue in ((0.0, False), (0.1, True), (0.2, True)):
+        shaded = [p for p in ax.patches if p.get_y() <= eps <= p.get_y() + p.get_height()
+                  and p.get_x() <= 2 * w0 <= p.get_x() + p.get_width()]
+        assert bool(shaded) == tongue, eps
+    assert [t.get_text() for t in ax.texts if t.get_gid() == "mark-label"] == ["2ω₀"]
     line = dataclasses.replace(chart, values=None, spectral_radius=chart.spectral_radius[2:],
                                stable=chart.stable[2:], converged=chart.converged[2:])
     assert plot_stability_chart(line, tmp_path / "line.png").stat().st_size > 5000

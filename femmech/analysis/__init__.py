@@ -3,6 +3,8 @@
 One job per module:
 
 * :mod:`.modes`: free vibration modes of an FE model or a superelement.
+* :mod:`.mode_types`: a mode's kind (bending, torsion, axial, rigid body) from energy
+  fractions.
 * :mod:`.sweep`: quasi-eigenfrequencies and quasi-modes of a coupled machine over the
   drive angle.
 * :mod:`.reference`: full (unreduced) coupled reference solves, reduced versus full.
@@ -14,6 +16,8 @@ One job per module:
 * :mod:`.response`: forced response in time (generalised-α), periodic steady states.
 * :mod:`.forces`: attachment, drive, support and section forces from time histories.
 * :mod:`.nonlinear`: time integration of the nonlinear mechanism equations (seed 5.2.1).
+* :mod:`.drive_events`: prescribed-drive load cases: static rest, run-up, trip at a
+  drive-force limit, braking (a crane's load-moment limiter, a press's overload clutch).
 * :mod:`.studies`: design studies as independent jobs on an executor (processes, Dask).
 
 Stage 5 (analysis): uses coupling, reduction, fe, mechanisms, solve and errors; nothing

@@ -287,8 +287,7 @@ def _beam_elements(model, elements) -> np.ndarray:
     for item in items:
         if isinstance(item, str):
             if item not in model.mesh.cell_sets:
-                raise ValueError(f"unknown element group {item!r}; the mesh has cell groups"
-                                 f" {sorted(model.mesh.cell_sets)}")
+                raise ValueError(model.mesh.unknown_cell_set(item, "element group"))
             idx = model.mesh.cell_sets[item].get("line", np.empty(0, dtype=np.int64))
             if not len(idx):
                 raise ValueError(f"element group {item!r} has no beam (line) elements")

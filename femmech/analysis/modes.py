@@ -13,6 +13,7 @@ import scipy.linalg
 from femmech.fe import checks
 from femmech.fe.dofs import DOF_PER_NODE
 from femmech.fe.model import FEModel
+from femmech.html import html_summary
 from femmech.reduction.estimate import frequency_error_estimates
 from femmech.reduction.superelement import Superelement
 from femmech.solve import direct
@@ -69,6 +70,19 @@ class ModeSet:
         shown = ", ".join(f"{x:.4g}" for x in f[:6]) + (", ..." if f.size > 6 else "")
         rigid = f", {int(np.sum(self.rigid))} rigid-body" if np.any(self.rigid) else ""
         return f"ModeSet({f.size} modes{rigid}: [{shown}] Hz; {self.method})"
+
+    def _repr_html_(self) -> str:
+        f, estimate = np.asarray(self.freq_hz), self.error_estimate
+        header = ("mode", "f / Hz", "rigid", "residual") + (
+            ("error estimate",) if estimate is not None else ())
+        rows = [(k + 1, float(f[k]), "yes" if self.rigid[k] else "", float(self.residual[k]))
+                + ((float(estimate[k]),) if estimate is not None else ())
+                for k in range(f.size)]
+        facts = [("method", self.method + (f" ({self.solver})" if self.solver else "")),
+                 ("shift σ / (rad/s)²", float(self.sigma)),
+                 ("Sturm count", "not checked" if self.sturm_count is None
+                  else self.sturm_count)]
+        return html_summary(f"ModeSet: {f.size} modes", facts, header, rows)
 
     @property
     def n_modes(self) -> int:

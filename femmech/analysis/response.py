@@ -40,6 +40,7 @@ from femmech.coupling import CoupledSystem, assemble_at, frame_row, require_dens
 from femmech.errors import ConvergenceWarning
 from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
 from femmech.fe.model import node_index
+from femmech.html import Flag, html_summary
 
 
 @dataclass(frozen=True)
@@ -81,6 +82,17 @@ class Response:
                  f"; error {self.error:.1e}" + ("" if self.converged else " NOT CONVERGED"))
         return (f"Response({t.size} times {t[0]:.4g}..{t[-1]:.4g} s, {np.shape(self.q)[-1]}"
                 f" coordinates{state})")
+
+    def _repr_html_(self) -> str:
+        t = np.asarray(self.t)
+        facts = [("times / s", f"{t.size}, {t[0]:.4g} … {t[-1]:.4g}"),
+                 ("coordinates", np.shape(self.q)[-1])]
+        if self.converged is not None:
+            facts.append(("estimated error", float(self.error) if self.converged
+                          else Flag(f"{self.error:.1e} NOT CONVERGED")))
+        if self.n_steps is not None:
+            facts.append(("steps per period", self.n_steps))
+        return html_summary("Response", facts)
 
 
 @dataclass(frozen=True)

@@ -28,6 +28,7 @@ from femmech.analysis.response import rayleigh_coefficients, rayleigh_damping
 from femmech.analysis.sweep import sweep
 from femmech.coupling import CoupledSystem
 from femmech.errors import ConvergenceWarning
+from femmech.html import Flag, html_summary
 
 
 @dataclass(frozen=True)
@@ -79,6 +80,22 @@ class StabilityChart:
         flags = f", {loose} NOT CONVERGED" if loose else ""
         return (f"StabilityChart({grid}; max spectral radius"
                 f" {np.nanmax(self.spectral_radius):.6g}, {n_unstable} unstable{flags})")
+
+    def _repr_html_(self) -> str:
+        rho = np.asarray(self.spectral_radius)
+        loose = self.unconverged
+        n_unstable = int(np.sum(~np.asarray(self.stable) & ~loose))
+        facts = [("speeds / (rad/s)", f"{len(self.speeds)}, {np.min(self.speeds):.4g} …"
+                                      f" {np.max(self.speeds):.4g}"),
+                 ("max spectral radius", float(np.nanmax(rho))),
+                 ("unstable points", n_unstable)]
+        if self.values is not None:
+            facts.insert(1, (self.parameter_name, f"{len(self.values)} values"))
+        if loose.any():
+            facts.append(("not converged", Flag(f"{int(loose.sum())} points NOT CONVERGED")))
+        if self.rtol is not None:
+            facts.append(("tolerance (relative)", float(self.rtol)))
+        return html_summary("StabilityChart", facts)
 
     @property
     def unconverged(self) -> np.ndarray:

@@ -28,6 +28,7 @@ import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
 from femmech.coupling import CoupledSystem
+from femmech.html import Flag, html_summary
 from femmech.solve import threads
 from femmech.solve.dense import dense_symmetric
 
@@ -99,6 +100,21 @@ class Sweep:
         band = f"{np.nanmin(f):.4g}..{np.nanmax(f):.4g} Hz" if f.size else "-"
         return (f"Sweep({phi.size} angles {phi.min():.4g}..{phi.max():.4g} deg,"
                 f" {f.shape[-1]} branches over {band}; {self.form})")
+
+    def _repr_html_(self) -> str:
+        f = np.asarray(self.freq_hz)
+        rows = []
+        for k in range(f.shape[-1]):
+            grows = bool(np.any(self.unstable[:, k]))
+            rows.append((k + 1, float(np.nanmin(f[:, k])), float(np.nanmax(f[:, k])),
+                         float(np.min(self.mac_step[:, k])),
+                         Flag("grows at some angles") if grows else ""))
+        phi = np.rad2deg(np.asarray(self.phi))
+        facts = [("drive angles", f"{phi.size}, {phi.min():.4g}° … {phi.max():.4g}°"),
+                 ("form", self.form)]
+        return html_summary(f"Sweep: {f.shape[-1]} branches", facts,
+                            ("branch", "min f / Hz", "max f / Hz", "min MAC step",
+                             "frozen-angle growth"), rows)
 
     @property
     def unstable(self) -> np.ndarray:

@@ -1,6 +1,7 @@
 """The mesh: points, cells by type, named cell sets and node sets (meshio conventions).
 
-Stage 2 (fe, independent of mechanisms): imports nothing of femmech.
+Stage 2 (fe, independent of mechanisms): imports only femmech.errors (message wording) and
+femmech.html (notebook view).
 """
 
 from __future__ import annotations
@@ -12,6 +13,9 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
+
+from femmech.errors import did_you_mean, name_list
+from femmech.html import html_summary
 
 NODES_PER_CELL = {
     "vertex": 1, "line": 2, "line3": 3, "triangle": 3, "quad": 4, "triangle6": 6,
@@ -101,6 +105,14 @@ class Mesh:
         return (f"Mesh({self.n_nodes} nodes; {cells}; {len(self.cell_sets)} cell sets,"
                 f" {len(self.node_sets)} node sets)")
 
+    def _repr_html_(self) -> str:
+        rows = [(kind, len(cells)) for kind, cells in self.cells.items()]
+        low, high = self.points.min(axis=0), self.points.max(axis=0)
+        facts = [("extent / m", " × ".join(f"{d:.4g}" for d in high - low)),
+                 ("cell sets", ", ".join(self.cell_sets) or "none"),
+                 ("node sets", ", ".join(self.node_sets) or "none")]
+        return html_summary(f"Mesh: {self.n_nodes} nodes", facts, ("cell kind", "cells"), rows)
+
     @property
     def n_nodes(self) -> int:
         """Number of nodes."""
@@ -173,7 +185,17 @@ class Mesh:
         if name in self.cell_sets:
             parts = [self.cells[kind][idx].ravel() for kind, idx in self.cell_sets[name].items()]
             return np.unique(np.concatenate(parts)) if parts else np.empty(0, dtype=np.int64)
-        raise ValueError(f"unknown group {name!r}; the mesh has {self.group_names()}")
+        names = self.group_names()
+        raise ValueError(f"unknown group {name!r}; the mesh has {name_list(names)}"
+                         f"{did_you_mean(name, names)}")
+
+    def unknown_cell_set(self, name: str, what: str = "group") -> str:
+        """Message for a cell set ``name`` that the mesh lacks: ``unknown group 'x'; the mesh
+        has cell sets [...]; did you mean 'y'?`` (and a note if ``x`` is a node set)."""
+        note = (f" ({name!r} is a node set; elements are named by cell sets)"
+                if name in self.node_sets else "")
+        return (f"unknown {what} {name!r}; the mesh has cell sets {name_list(self.cell_sets)}"
+                f"{did_you_mean(name, self.cell_sets)}{note}")
 
 
 def merged_node_index(points: np.ndarray, tol: float, keep=()) -> np.ndarray:

@@ -1,6 +1,14 @@
-"""Mesh input through meshio (Gmsh .msh, VTU, XDMF, ... anything meshio reads).
+"""Mesh input through meshio (Gmsh .msh, Abaqus .inp, Nastran .bdf, VTU, MED, ... anything
+meshio reads), with the file's node and element sets as :class:`Mesh` node and cell sets.
 
-Stage 2 (fe, independent of mechanisms): uses only fe.mesh (and meshio).
+Where the groups of each format come from is in :mod:`femmech.fe.mesh_sets`; Abaqus decks
+and Nastran bulk data have their sets read by femmech itself, because meshio 5 loses or
+garbles them (:mod:`femmech.fe.abaqus_sets`, :mod:`femmech.fe.nastran_sets`). A mesh file
+is untrusted input: its size, node and cell counts and every set are checked, and every
+problem is one :class:`~femmech.errors.FileFormatError` line naming the file and the item.
+
+Stage 2 (fe, independent of mechanisms): uses fe.mesh, fe.mesh_sets, fe.abaqus_sets,
+fe.nastran_sets (and meshio).
 """
 
 from __future__ import annotations
@@ -11,117 +19,117 @@ from pathlib import Path
 
 import numpy as np
 
+from femmech.errors import FileFormatError
+from femmech.fe import abaqus_sets, nastran_sets
 from femmech.fe.mesh import MAX_CELLS, MAX_NODES, NODES_PER_CELL, Mesh
+from femmech.fe.mesh_sets import collect_sets
 
 MAX_MESH_FILE_BYTES = 4 * 2**30
 """Largest mesh file read, bytes (an ASCII Gmsh file of a million nodes and five million
 tetrahedra has about 400 MB); a mesh file is untrusted input, refused before reading."""
+ABAQUS_SUFFIXES = (".inp",)
+NASTRAN_SUFFIXES = (".bdf", ".fem", ".nas")
+"""File name endings meshio reads as Abaqus and as Nastran (``meshio.extension_to_filetypes``)."""
 
 
 def from_meshio(mesh) -> Mesh:
-    """Convert a ``meshio.Mesh``: cell blocks of one type are merged, cell sets (Gmsh
-    physical groups) become :attr:`Mesh.cell_sets`, and sets made of vertex cells
-    (Gmsh physical points) become :attr:`Mesh.node_sets`. Sets named ``gmsh:*`` are
-    ignored.
+    """Convert a ``meshio.Mesh``: cell blocks of one type are merged (in block order), and
+    the groups of every form meshio returns (:func:`femmech.fe.mesh_sets.collect_sets`)
+    become :attr:`Mesh.node_sets` and :attr:`Mesh.cell_sets`; vertex cells are not kept
+    (a set of vertex cells, a Gmsh physical point, becomes a node set).
 
-    Readers that return groups as integer cell data instead of cell sets are decoded
-    too: Gmsh 2.2 files (``gmsh:physical`` tags named by ``field_data``) and files such
-    as VTU to which meshio wrote cell sets as one integer array named ``"a-b-c"`` (value
-    ``k`` = set ``k``, -1 = none; see ``meshio.Mesh.cell_sets_to_data``).
+    Raises
+    ------
+    FileFormatError
+        An unsupported cell type, or a set that is not valid (naming it).
     """
     offsets, cells = [], {}
     for block in mesh.cells:
         if block.type not in NODES_PER_CELL:
-            raise ValueError(f"unsupported cell type {block.type!r} in the mesh file")
+            raise FileFormatError(f"unsupported cell type {block.type!r} in the mesh file"
+                                  f" (femmech reads {sorted(NODES_PER_CELL)})")
         cells.setdefault(block.type, [])
         offsets.append(sum(len(c) for c in cells[block.type]))
         cells[block.type].append(np.asarray(block.data))
     merged = {kind: np.concatenate(parts) for kind, parts in cells.items()}
-    cell_sets, node_sets = {}, {}
-    raw_sets = {k: v for k, v in mesh.cell_sets.items() if not k.startswith("gmsh:")}
-    for name, per_block in (raw_sets or _sets_from_cell_data(mesh)).items():
+    node_sets, raw_cell_sets = collect_sets(mesh)
+    cell_sets = {}
+    for name, per_block in raw_cell_sets.items():
         by_type = {}
         for block, offset, idx in zip(mesh.cells, offsets, per_block, strict=True):
-            if idx is None or len(idx) == 0:
-                continue
-            idx = np.asarray(idx)
-            if idx.dtype.kind not in "iu" or idx.min() < 0 or idx.max() >= len(block.data):
-                raise ValueError(f"group {name!r} references {block.type} cells outside the"
-                                 f" {len(block.data)} of its block")
-            by_type.setdefault(block.type, []).append(idx.astype(np.int64) + offset)
-        by_type = {kind: np.concatenate(parts) for kind, parts in by_type.items()}
-        if set(by_type) == {"vertex"}:
-            node_sets[name] = np.unique(merged["vertex"][by_type["vertex"]])
-            if node_sets[name].dtype.kind not in "iu":
-                raise ValueError(f"node group {name!r}: vertex cells must hold node indices")
-        else:
-            by_type.pop("vertex", None)
-            cell_sets[name] = by_type
+            if idx is not None and len(idx) and block.type != "vertex":
+                by_type.setdefault(block.type, []).append(idx + offset)
+        cell_sets[name] = {kind: np.concatenate(parts) for kind, parts in by_type.items()}
     merged.pop("vertex", None)
-    return Mesh(mesh.points, merged, cell_sets, node_sets)
-
-
-def _sets_from_cell_data(mesh) -> dict:
-    """Cell sets (name → index array per block) from integer cell data, see from_meshio."""
-    data = mesh.cell_data
-    if "gmsh:physical" in data:
-        names = {(int(v[0]), int(v[1])): k for k, v in mesh.field_data.items() if len(v) == 2}
-        out = {}
-        for k, (block, tags) in enumerate(zip(mesh.cells, data["gmsh:physical"], strict=True)):
-            tags = np.asarray(tags)
-            for tag in np.unique(tags[tags > 0]):
-                name = names.get((int(tag), _CELL_DIM.get(block.type, -1)), str(tag))
-                out.setdefault(name, [None] * len(mesh.cells))[k] = np.flatnonzero(tags == tag)
-        return out
-    out = {}
-    for key, arrays in data.items():
-        names = key.split("-")
-        values = [np.asarray(a) for a in arrays]
-        if (key.startswith("gmsh:") or len(set(names)) != len(names)
-                or not all(v.dtype.kind in "iu" and v.ndim == 1 for v in values)
-                or any(v.size and (v.min() < -1 or v.max() >= len(names)) for v in values)):
-            continue
-        for i, name in enumerate(names):
-            out[name] = [np.flatnonzero(v == i) for v in values]
-    return out
-
-
-_CELL_DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "quad": 2, "triangle6": 2,
-             "quad8": 2, "quad9": 2, "tetra": 3, "tetra10": 3, "hexahedron": 3,
-             "hexahedron20": 3, "hexahedron27": 3, "wedge": 3}
+    return Mesh(mesh.points, merged, cell_sets,
+                {name: np.unique(idx) for name, idx in node_sets.items()})
 
 
 def read_mesh(path) -> Mesh:
-    """Read any meshio-readable file (e.g. Gmsh ``.msh``) into a :class:`Mesh`.
+    """Read any meshio-readable file (Gmsh ``.msh``, Abaqus ``.inp``, Nastran ``.bdf``, VTU,
+    ...) into a :class:`Mesh` with the file's node and element sets (module docstring).
 
-    Raises FileNotFoundError naming the path, or ValueError naming the file and the
-    problem.
+    Raises
+    ------
+    FileNotFoundError
+        Naming the path.
+    FileFormatError
+        (a ValueError) naming the file and the problem: a file too large, unreadable,
+        with too many nodes or cells, an unsupported cell type, or a set that is not valid
+        (naming the set).
     """
-    import meshio
-
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"mesh file not found: {path}")
     size = path.stat().st_size
     if size > MAX_MESH_FILE_BYTES:
-        raise ValueError(f"{path}: file of {size} bytes; at most {MAX_MESH_FILE_BYTES}"
-                         " (limit MAX_MESH_FILE_BYTES)")
+        raise FileFormatError(f"{path}: file of {size} bytes; at most {MAX_MESH_FILE_BYTES}"
+                              " (limit MAX_MESH_FILE_BYTES)")
+    suffix = path.suffix.lower()
+    try:  # an Abaqus deck is scanned first: it bounds what meshio would allocate
+        deck = abaqus_sets.scan_deck(path) if suffix in ABAQUS_SUFFIXES else None
+        if deck is not None:
+            _check_counts(len(deck.node_ids), sum(len(ids) for _, ids in deck.blocks))
+            abaqus_sets.check_numbers(deck)
+        raw = _meshio_read(path, "abaqus" if deck is not None else None)
+        _check_counts(len(raw.points), sum(len(block.data) for block in raw.cells))
+        if deck is not None:
+            raw.point_sets, raw.cell_sets = abaqus_sets.deck_sets(deck, raw)
+        elif suffix in NASTRAN_SUFFIXES:
+            nastran_sets.add_sets(path, raw)
+        return from_meshio(raw)
+    except (ValueError, TypeError) as exc:  # FileFormatError, Mesh's checks
+        raise FileFormatError(f"{path}: {exc}") from None
+
+
+def _check_counts(n_points: int, n_cells: int) -> None:
+    if n_points > MAX_NODES or n_cells > MAX_CELLS:
+        raise FileFormatError(f"{n_points} nodes and {n_cells} cells; at most {MAX_NODES} and"
+                              f" {MAX_CELLS} (limits MAX_NODES, MAX_CELLS)")
+
+
+def _meshio_read(path: Path, deck_format: str | None = None):
+    """``meshio.read``, its own printed warnings kept, every failure a FileFormatError; an
+    Abaqus deck (``deck_format="abaqus"``) is read without its set blocks
+    (:class:`femmech.fe.abaqus_sets.WithoutSets`)."""
+    import meshio
+
     said = io.StringIO()  # meshio prints warnings and errors of its own; keep them
     try:
         with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
-            raw = meshio.read(path)
+            if deck_format is None:
+                return meshio.read(path)
+            with open(path, encoding="utf-8", errors="replace") as f:
+                return meshio.read(abaqus_sets.WithoutSets(f), deck_format)
+    except KeyError as exc:
+        if deck_format == "abaqus":  # sets are hidden from meshio: an element's node
+            raise FileFormatError(f"an element lists node {exc.args[0]}, which the *NODE"
+                                  " block does not define") from None
+        raise FileFormatError(f"meshio could not read the file (KeyError: {exc})") from None
     except Exception as exc:  # meshio raises many types; report them uniformly
-        raise ValueError(f"{path}: meshio could not read the file ({exc})") from exc
-    except SystemExit as exc:  # meshio 5.3 calls sys.exit(1) when no reader succeeds
+        raise FileFormatError(f"meshio could not read the file ({type(exc).__name__}:"
+                              f" {exc})") from None
+    except SystemExit:  # meshio 5.3 calls sys.exit(1) when no reader succeeds
         first = " ".join(said.getvalue().split())[:200]
-        raise ValueError(f"{path}: meshio could not read the file (no reader for its"
-                         f" extension accepted the contents: {first})") from exc
-    n_points = len(raw.points)
-    n_cells = sum(len(block.data) for block in raw.cells)
-    if n_points > MAX_NODES or n_cells > MAX_CELLS:
-        raise ValueError(f"{path}: {n_points} nodes and {n_cells} cells; at most {MAX_NODES}"
-                         f" and {MAX_CELLS} (limits MAX_NODES, MAX_CELLS)")
-    try:
-        return from_meshio(raw)
-    except (ValueError, TypeError) as exc:
-        raise ValueError(f"{path}: {exc}") from exc
+        raise FileFormatError("meshio could not read the file (no reader for its extension"
+                              f" accepted the contents: {first})") from None

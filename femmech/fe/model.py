@@ -45,6 +45,7 @@ from femmech.fe.parts import (
     solid_parts,
 )
 from femmech.fe.sections import BeamSection
+from femmech.html import html_summary
 
 
 @dataclass(frozen=True)
@@ -56,11 +57,21 @@ class BeamProperty:
     section : BeamSection
     material : Material
     orientation : array_like (3,), optional
-        Vector in the local x-y plane (see :func:`femmech.fe.elements.beam.local_frames`).
+        Orientation vector (global coordinates, any length), in the plane that
+        ``orientation_plane`` names. Default: the rule of
+        :func:`femmech.fe.elements.beam.local_frames` (local z upwards).
     shear : bool
         Timoshenko shear deformation; False gives Euler-Bernoulli bending.
     rotary_inertia : bool
         Include the rotary inertia of bending.
+    orientation_plane : ``"xy"`` or ``"xz"``
+        Which local plane ``orientation`` lies in. ``"xy"`` (default): it points towards
+        local y, as Nastran's CBAR/CBEAM vector v and the direction line of an
+        Abaqus/CalculiX ``*BEAM SECTION`` (the n1 axis; their t, n1, n2 are x, y, z).
+        ``"xz"``: it points towards local z, as OpenSees' ``vecxz`` of ``geomTransf`` and
+        an Abaqus ``*NORMAL`` (n2); converted exactly (local z = the part of the vector
+        normal to the axis, local y = z × x, :func:`xz_to_xy`). A vector copied with the
+        wrong plane turns the section by 90° without an error.
     """
 
     section: BeamSection
@@ -68,6 +79,7 @@ class BeamProperty:
     orientation: object = None
     shear: bool = True
     rotary_inertia: bool = True
+    orientation_plane: str = "xy"
 
 
 # columns of BeamSet.properties: the arguments of elements.beam.local_matrices (after the
@@ -156,6 +168,14 @@ class FEModel:
         kinds = ", ".join(f"{len(c)} {k}" for k, c in self.mesh.cells.items())
         return (f"FEModel({self.mesh.n_nodes} nodes, {kinds}; {self.n_dof} DOFs,"
                 f" {self.n_free} free; K, M sparse with {self.K_free.nnz} non-zeros)")
+
+    def _repr_html_(self) -> str:
+        rows = [(kind, len(cells)) for kind, cells in self.mesh.cells.items()]
+        facts = [("DOFs", f"{self.n_dof} ({self.n_free} free)"),
+                 ("total mass / kg", self.total_mass()),
+                 ("K, M", f"sparse, {self.K_free.nnz} non-zeros (free DOFs)")]
+        return html_summary(f"FEModel: {self.mesh.n_nodes} nodes", facts,
+                            ("cell kind", "elements"), rows)
 
     @property
     def n_dof(self) -> int:
@@ -371,8 +391,7 @@ def _beam_blocks(mesh: Mesh, beams: dict[str, BeamProperty], with_shells: bool =
     names = list(beams)
     for g, name in enumerate(names):
         if name not in mesh.cell_sets:
-            raise ValueError(f"beam property for unknown group {name!r};"
-                             f" the mesh has cell sets {sorted(mesh.cell_sets)}")
+            raise ValueError(f"beam property for {mesh.unknown_cell_set(name)}")
         idx = mesh.cell_sets[name].get("line", np.empty(0, dtype=np.int64))
         twice = idx[owner[idx] >= 0]
         if twice.size:
@@ -386,7 +405,7 @@ def _beam_blocks(mesh: Mesh, beams: dict[str, BeamProperty], with_shells: bool =
         raise ValueError(f"line element {e} (nodes {lines[e].tolist()}) has no beam property"
                          f" ({missing.size} such elements); its groups: {groups}")
     props = [beams[n] for n in names]
-    orient = _orientations(mesh, lines, owner, props)
+    orient = _orientations(mesh, lines, owner, props, names)
     R, length = local_frames(mesh.points, lines, orient)
     table = np.array([_property_row(p) for p in props]).reshape(len(props), 12)
     rows = table[owner] if len(lines) else np.zeros((0, 12))
@@ -409,19 +428,47 @@ def _property_row(p: BeamProperty) -> list[float]:
             float(p.rotary_inertia), s.draw_radius]
 
 
-def _orientations(mesh, lines, owner, props) -> np.ndarray:
-    """Per-element orientation vectors; groups without one use the default rule."""
+def _orientations(mesh, lines, owner, props, names=None) -> np.ndarray:
+    """Per-element orientation vectors in the local x-y plane; groups without one use the
+    default rule, vectors given in the x-z plane are converted (:func:`xz_to_xy`).
+    ``names`` (of the groups, for messages) defaults to their positions."""
     R_default, _ = local_frames(mesh.points, lines, None) if len(lines) else (np.zeros((0, 3, 3)),
                                                                               None)
     orient = R_default[:, 1, :].copy()
+    names = list(range(len(props))) if names is None else names
     for g, p in enumerate(props):
+        if p.orientation_plane not in ("xy", "xz"):
+            raise ValueError(f"beams[{names[g]!r}]: orientation_plane must be 'xy' or 'xz',"
+                             f" got {p.orientation_plane!r}")
         if p.orientation is not None:
             v = np.asarray(p.orientation, dtype=float)
             if v.shape != (3,) or not np.isfinite(v).all() or not np.any(v):
                 raise ValueError(f"orientation of a beam group must be a non-zero 3-vector,"
                                  f" got {p.orientation!r}")
-            orient[owner == g] = v
+            mine = np.flatnonzero(owner == g)
+            orient[mine] = v if p.orientation_plane == "xy" else xz_to_xy(
+                R_default[mine, 0, :], v, f"beams[{names[g]!r}]", mine)
     return orient
+
+
+def xz_to_xy(ex: np.ndarray, v: np.ndarray, label: str = "orientation",
+             elements=None) -> np.ndarray:
+    """Local y axes (n, 3) of elements with axes ``ex`` (n, 3, unit) from a vector ``v``
+    (3,) in their local x-z plane: z = normalised part of ``v`` normal to x, y = z × x.
+
+    Raises ValueError naming ``label`` and the element (``elements[i]``, default i) if
+    ``v`` is parallel to an axis.
+    """
+    ez = v - (ex @ v)[:, None] * ex
+    nz = np.linalg.norm(ez, axis=1)
+    bad = np.flatnonzero(~(nz > 1e-6 * np.linalg.norm(v)))
+    if bad.size:
+        e = int(bad[0] if elements is None else elements[bad[0]])
+        raise ValueError(f"{label}: orientation vector {v.tolist()} (orientation_plane 'xz')"
+                         f" is parallel to the axis {ex[bad[0]].round(6).tolist()} of line"
+                         f" element {e}")
+    ez /= nz[:, None]
+    return np.cross(ez, ex)
 
 
 def node_index(mesh: Mesh, ref, what: str) -> int:

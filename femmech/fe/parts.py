@@ -148,8 +148,7 @@ def _owner(mesh: Mesh, kind: str, names: list[str], what: str) -> np.ndarray:
 def _check_groups(mesh: Mesh, names, kinds, what: str) -> None:
     for name in names:
         if name not in mesh.cell_sets:
-            raise ValueError(f"{what} property for unknown group {name!r};"
-                             f" the mesh has cell sets {sorted(mesh.cell_sets)}")
+            raise ValueError(f"{what} property for {mesh.unknown_cell_set(name)}")
         if not any(len(mesh.cell_sets[name].get(k, ())) for k in kinds):
             raise ValueError(f"{what} property for group {name!r}, which has no"
                              f" {' or '.join(kinds)} cells")

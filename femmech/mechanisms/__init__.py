@@ -61,7 +61,6 @@ from femmech.mechanisms.position import PositionFunction
 from femmech.mechanisms.quasi_modes import (
     QuasiModes,
     frozen_eigen,
-    plot_quasi_frequencies,
     quasi_modes,
 )
 from femmech.mechanisms.symbolic import (
@@ -118,7 +117,6 @@ __all__ = [
     "processing_machine_cams",
     "processing_machine_mixed",
     "processing_machine_parameters",
-    "plot_quasi_frequencies",
     "quasi_modes",
     "rheolinear",
     "rheolinear_terms",

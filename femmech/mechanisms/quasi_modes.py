@@ -11,19 +11,18 @@ potential part and ``scipy.linalg.eigh`` is used; otherwise C is generally unsym
 (errata item 30) and ``scipy.linalg.eig`` is used. Damping B is ignored (undamped
 quasi-modes).
 
-Stage 2 (mechanisms, independent of fe): imports nothing of femmech (matplotlib only inside
-the plot function).
+The diagram of the quasi-eigenfrequencies over the drive angle is
+:func:`femmech.output.sweeps.plot_quasi_frequencies`.
+
+Stage 2 (mechanisms, independent of fe): imports nothing of femmech.
 """
 
-import os
-import tempfile
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import scipy.linalg
 
-__all__ = ["QuasiModes", "frozen_eigen", "plot_quasi_frequencies", "quasi_modes"]
+__all__ = ["QuasiModes", "frozen_eigen", "quasi_modes"]
 
 
 @dataclass(frozen=True)
@@ -128,55 +127,3 @@ def quasi_modes(model, phi, Omega=0.0, Omega_dot=0.0) -> QuasiModes:
     ok = (np.abs(lam.imag) <= 1e-9 * np.abs(lam)) & (lam.real > 0)
     freq = np.where(ok, np.sqrt(np.abs(lam.real)) / (2 * np.pi), np.nan)
     return QuasiModes(phi, lam, freq, modes, sym)
-
-
-def plot_quasi_frequencies(curves: dict[str, QuasiModes], filename, title: str = "") -> Path:
-    """Plot quasi-eigenfrequencies (Hz) over the drive angle (degrees) into a PNG.
-
-    Parameters
-    ----------
-    curves : dict of str to QuasiModes
-        Label → result; each result's frequencies are drawn with one line style.
-    filename : str or path-like
-        Target PNG; written to a temporary file in the same folder, then renamed.
-    title : str
-        Figure title.
-
-    Returns
-    -------
-    Path
-        The written file.
-    """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(10, 5), dpi=120)
-    FigureCanvasAgg(fig)
-    ax = fig.add_subplot()
-    styles = ["-", "--", ":", "-."]
-    for i, (label, res) in enumerate(curves.items()):
-        deg = np.rad2deg(res.phi)
-        for k in range(res.freq_hz.shape[1]):
-            ax.plot(deg, res.freq_hz[:, k], styles[i % 4], color=f"C{k}",
-                    label=f"{label}: f{k + 1}")
-    ax.set_xlabel("drive angle φ (°)")
-    ax.set_ylabel("quasi-eigenfrequency (Hz)")
-    ax.set_xlim(0, 360)
-    ax.set_xticks(np.arange(0, 361, 45))
-    ax.set_yscale("log")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
-    if title:
-        ax.set_title(title)
-    fig.tight_layout()
-    target = Path(filename)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".png", dir=target.parent)
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            fig.savefig(handle, format="png")
-        os.replace(tmp, target)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-    return target

@@ -1,7 +1,7 @@
 """Time histories of a forced response: panels over time, orbits, CSV tables.
 
-Stage 6 (output): uses only output.export (atomic writes); arrays come in, and
-matplotlib is imported inside the functions.
+Stage 6 (output): uses output.export (atomic writes) and output.charts (angle ticks);
+arrays come in, and matplotlib is imported inside the functions.
 """
 
 from __future__ import annotations
@@ -10,11 +10,12 @@ from pathlib import Path
 
 import numpy as np
 
+from femmech.output.charts import set_angle_axis
 from femmech.output.export import atomic_path
 
 
 def plot_time_histories(t, panels: dict, filename, title: str = "",
-                        xlabel: str = "time (s)") -> Path:
+                        xlabel: str = "time (s)", angle_deg: bool = False) -> Path:
     """Time histories in stacked panels sharing the time axis (PNG).
 
     Parameters
@@ -23,8 +24,23 @@ def plot_time_histories(t, panels: dict, filename, title: str = "",
         Times (or drive angles: set ``xlabel``).
     panels : dict
         ``{y_label: {curve_label: values (n_t,)}}``, one panel per entry, top to bottom;
-        the y label carries the unit, e.g. ``"force (kN)"``.
+        the y label carries the unit, e.g. ``"force (kN)"``. A curve with its own times
+        is given as a pair ``(times (m,), values (m,))`` instead of ``values``. A panel
+        of several curves has its legend right of it, outside the plot (none when it
+        names the same curves as the panel above).
+    angle_deg : bool
+        ``t`` are drive angles in degrees: the axis spans them with ticks every 45° (up
+        to one revolution) or 90°.
     """
+    fig = time_histories_figure(t, panels, title, xlabel, angle_deg)
+    with atomic_path(filename) as tmp:
+        fig.savefig(tmp, format="png")
+    return Path(filename)
+
+
+def time_histories_figure(t, panels: dict, title: str = "", xlabel: str = "time (s)",
+                          angle_deg: bool = False):
+    """The matplotlib Figure of :func:`plot_time_histories` (same arguments)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -33,26 +49,37 @@ def plot_time_histories(t, panels: dict, filename, title: str = "",
         raise ValueError("plot_time_histories needs at least one panel")
     for ylabel, curves in panels.items():
         for label, values in curves.items():
-            if np.shape(values) != t.shape:
-                raise ValueError(f"panel {ylabel!r}, curve {label!r}: expected {t.shape[0]}"
-                                 f" values (one per time), got shape {np.shape(values)}")
-    fig = Figure(figsize=(7.5, 1.0 + 2.0 * len(panels)), dpi=120)
+            times, values = _curve(t, values)
+            if np.shape(values) != times.shape:
+                raise ValueError(f"panel {ylabel!r}, curve {label!r}: expected"
+                                 f" {times.shape[0]} values (one per time), got shape"
+                                 f" {np.shape(values)}")
+    fig = Figure(figsize=(8.5, 1.0 + 2.0 * len(panels)), dpi=120, layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
+    above = None
     for ax, (ylabel, curves) in zip(axes, panels.items(), strict=True):
         for label, values in curves.items():
-            ax.plot(t, values, lw=1.0, label=label)
+            ax.plot(*_curve(t, values), lw=1.0, label=label)
         ax.set_ylabel(ylabel)
         ax.grid(True, lw=0.3)
-        if len(curves) > 1:
-            ax.legend(fontsize=7, loc="upper right", ncols=min(4, len(curves)))
+        if len(curves) > 1 and list(curves) != above:
+            ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0),
+                      borderaxespad=0.0)
+        above = list(curves)
     axes[-1].set_xlabel(xlabel)
+    if angle_deg and t.size:
+        set_angle_axis(axes[-1], float(t.min()), float(t.max()))
     if title:
-        axes[0].set_title(title)
-    fig.tight_layout()
-    with atomic_path(filename) as tmp:
-        fig.savefig(tmp, format="png")
-    return Path(filename)
+        fig.suptitle(title, fontsize=11)
+    return fig
+
+
+def _curve(t: np.ndarray, values):
+    """(times, values) of a curve given as values on ``t`` or as a (times, values) pair."""
+    if isinstance(values, tuple) and len(values) == 2:
+        return np.asarray(values[0], dtype=float), values[1]
+    return t, values
 
 
 def plot_orbit(x, y, filename, xlabel: str = "x", ylabel: str = "y", title: str = "",
@@ -69,7 +96,7 @@ def plot_orbit(x, y, filename, xlabel: str = "x", ylabel: str = "y", title: str 
     if x.shape != y.shape or x.ndim != 1 or x.size < 3:
         raise ValueError(f"x and y must be 1D with the same length >= 3, got {x.shape},"
                          f" {y.shape}")
-    fig = Figure(figsize=(5.0, 5.0), dpi=120)
+    fig = Figure(figsize=(5.0, 5.0), dpi=120, layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     ax.plot(x, y, color="k", lw=1.0)
@@ -84,7 +111,6 @@ def plot_orbit(x, y, filename, xlabel: str = "x", ylabel: str = "y", title: str 
     ax.grid(True, lw=0.3)
     if title:
         ax.set_title(title)
-    fig.tight_layout()
     with atomic_path(filename) as tmp:
         fig.savefig(tmp, format="png")
     return Path(filename)
@@ -101,4 +127,39 @@ def write_history_csv(t, columns: dict, filename, time_label: str = "t_s") -> Pa
     with atomic_path(filename) as tmp:
         np.savetxt(tmp, rows, delimiter=",", header=",".join([time_label, *columns]),
                    comments="", fmt="%.10g")
+    return Path(filename)
+
+
+def plot_event_histories(panels: dict, filename, event: tuple | None = None,
+                         levels: dict | None = None, title: str = "",
+                         xlabel: str = "time (s)") -> Path:
+    """Time histories of runs that share a start and part at an event (PNG).
+
+    Parameters
+    ----------
+    panels : dict
+        ``{y_label: {curve_label: (times (m,), values (m,))}}``, one panel per entry, top
+        to bottom; each curve has its own times (runs of different lengths).
+    event : (float, str), optional
+        Time (s) and name of the event (e.g. a trip): a dotted vertical line on every
+        panel, named on the top one.
+    levels : dict, optional
+        ``{y_label: (value, text)}``: a dashed horizontal line with its text on that
+        panel (e.g. the force limit).
+    """
+    fig = time_histories_figure(np.zeros(0), panels, title, xlabel)
+    for ax, ylabel in zip(fig.axes, panels, strict=True):
+        if event is not None:
+            ax.axvline(event[0], color="k", lw=0.8, ls=":")
+        if levels and ylabel in levels:
+            value, text = levels[ylabel]
+            ax.axhline(value, color="k", lw=0.8, ls="--")
+            ax.annotate(text, (0.01, value), xycoords=("axes fraction", "data"),
+                        xytext=(0, 3), textcoords="offset points", fontsize=8)
+    if event is not None and fig.axes:
+        fig.axes[0].annotate(f" {event[1]}", (event[0], 1.0),
+                             xycoords=("data", "axes fraction"), xytext=(2, -10),
+                             textcoords="offset points", fontsize=8)
+    with atomic_path(filename) as tmp:
+        fig.savefig(tmp, format="png")
     return Path(filename)

@@ -5,9 +5,11 @@ superelement when the frame is reduced) and drawn with :func:`plot_mode`; each m
 mechanism is drawn schematically at its first translational attachment: a connector
 from the (displaced) frame node to a block that stands for the mechanism's moving body,
 displaced by the mechanism coordinate of largest amplitude along the attachment
-direction.
+direction. The title states the frequency, the drive angle (``φ = 45°``) and speed, the
+legend lists the mechanism glyph next to the frame's.
 
-Stage 6 (output): uses analysis.modes, coupling, reduction, fe and output.plot.
+Stage 6 (output): uses analysis.modes, coupling, reduction, fe and output.plot,
+.mode_geometry, .annotate and .renderer.
 """
 
 from __future__ import annotations
@@ -20,11 +22,15 @@ from femmech.analysis.modes import ModeSet
 from femmech.coupling import CoupledSystem, _weights
 from femmech.fe.dofs import DOF_PER_NODE
 from femmech.fe.model import FEModel, node_index
-from femmech.output.plot import SCALE_FRACTION, model_size, plot_mode
+from femmech.output.annotate import LegendEntry
+from femmech.output.charts import format_speed
+from femmech.output.mode_geometry import SCALE_FRACTION, marker_size, model_size
+from femmech.output.plot import _plot
+from femmech.output.renderer import Decoration
 from femmech.reduction.superelement import Superelement
 
-MECHANISM_COLOR = "#e07b00"
-OFFSET_FRACTION = 0.06
+MECHANISM_COLOR = "#ff7f00"
+OFFSET_FRACTION = 0.08
 """Distance of a mechanism's block from its attachment node, fraction of the model size."""
 
 
@@ -42,8 +48,26 @@ def frame_shape(system: CoupledSystem, x: np.ndarray) -> np.ndarray:
     raise TypeError("frame_shape supports Superelement and FEModel frames")
 
 
+def coupled_title(freq_hz: float, angle: float | None = None, speed: float | None = None,
+                  number: int | None = None, speed_unit: str = "rpm") -> str:
+    """Title of a coupled-mode image: ``"Coupled mode 1: 60.54 Hz at φ = 90°, speed 300 rpm"``.
+
+    ``angle`` is the drive angle in rad (shown in degrees, to 0.1°), ``speed`` the drive
+    speed in rad/s (shown in ``speed_unit``: "rpm", "rad/s" or "Hz"), ``number`` the
+    mode's number from 1.
+    """
+    text = "Coupled mode" + (f" {number}" if number is not None else "") + f": {freq_hz:.2f} Hz"
+    if angle is not None:
+        text += f" at φ = {float(np.rad2deg(angle)):.4g}°"
+    if speed is not None:
+        text += f"{',' if angle is not None else ' at'} speed {format_speed(speed, speed_unit)}"
+    return text
+
+
 def plot_coupled_mode(model: FEModel, system: CoupledSystem, x: np.ndarray, freq_hz: float,
-                      filename, angle: float | None = None, **kwargs) -> Path:
+                      filename, angle: float | None = None, speed: float | None = None,
+                      mode_number: int | None = None, speed_unit: str = "rpm",
+                      **kwargs) -> Path:
     """Render one coupled quasi-mode (frame + mechanisms) to a PNG file.
 
     Parameters
@@ -57,28 +81,62 @@ def plot_coupled_mode(model: FEModel, system: CoupledSystem, x: np.ndarray, freq
         Its quasi-eigenfrequency, Hz (for the title).
     filename : str or os.PathLike
     angle : float, optional
-        Drive angle, rad (for the title).
+        Drive angle, rad (title: ``φ = 45°``).
+    speed : float, optional
+        Drive speed Ω the mode was solved at, rad/s (title: in ``speed_unit``).
+    mode_number : int, optional
+        Number of the mode from 1 (title: ``Coupled mode 1``).
+    speed_unit : str
+        ``"rpm"`` (default), ``"rad/s"`` or ``"Hz"``, for the title.
     **kwargs
-        Passed to :func:`plot_mode` (``window_size``, ``camera``, ``scale``, ...). The
-        default scale draws the largest of the frame and mechanism displacements as
-        :data:`~femmech.output.plot.SCALE_FRACTION` of the model size.
+        Passed to :func:`plot_mode` (``window_size``, ``camera``, ``scale``,
+        ``mode_type``, ...). The default scale draws the largest of the frame and
+        mechanism displacements as :data:`~femmech.output.plot.SCALE_FRACTION` of the
+        model size, and the camera (with the default scale) is then the same for every
+        coupled mode of the model: fitted to the undeformed frame and mechanisms grown by
+        that largest displacement. The mode type is off by default (it would describe the
+        frame only).
     """
     u = frame_shape(system, x)
     modes = ModeSet(np.array([freq_hz]), np.array([(2 * np.pi * freq_hz) ** 2]), u[:, None],
                     np.array([False]), "coupled", 0.0, np.zeros(1), None)
-    title = f"Coupled mode: {freq_hz:.2f} Hz"
-    if angle is not None:
-        title += f" at phi = {np.rad2deg(angle):.0f} deg"  # VTK's font lacks φ and °
     glyphs = _mechanism_glyphs(model, system, np.real_if_close(x), u)
     if kwargs.get("scale") is None:
         largest = max([np.abs(u.reshape(-1, DOF_PER_NODE)[:, :3]).max()]
                       + [abs(g[3]) for g in glyphs])
         kwargs["scale"] = SCALE_FRACTION * model_size(model) / largest if largest > 0 else 1.0
+        kwargs["scale_note"] = True
+        # nothing moves further than SCALE_FRACTION of the size: one camera for every
+        # coupled mode of this model (all angles, speeds and modes look alike)
+        kwargs.setdefault("reach", SCALE_FRACTION * model_size(model))
+    kwargs.setdefault("mode_type", False)
+    decoration = mechanism_decoration(glyphs, model_size(model), marker_size(model))
+    return _plot(model, modes, [0], [Path(filename)], workers=1, decorate=decoration,
+                 title=coupled_title(freq_hz, angle, speed, mode_number, speed_unit), **kwargs)[0]
 
-    def decorate(plotter, scale):
-        _draw_mechanisms(plotter, glyphs, scale, OFFSET_FRACTION * model_size(model))
 
-    return plot_mode(model, modes, 0, filename, title=title, decorate=decorate, **kwargs)
+def mechanism_decoration(glyphs, size: float, marker: float) -> Decoration:
+    """The mechanisms of :func:`_mechanism_glyphs` as a :class:`Decoration`: a connector
+    tube from the displaced attachment node to a block for the mechanism's moving body,
+    :data:`OFFSET_FRACTION` of the model size (``size``, m) away, displaced by its
+    coordinate; ``marker`` (m) sets the connector's radius."""
+    offset = OFFSET_FRACTION * size
+    edge = 0.5 * offset
+
+    def ends(scale):
+        return [(point + scale * frame_u, point - offset * d + scale * body * d)
+                for point, frame_u, d, body in glyphs]
+
+    def draw(plotter, scale):
+        _draw_mechanisms(plotter, ends(scale), edge, 0.4 * marker)
+
+    def points(scale):  # the corners of the blocks
+        corners = 0.5 * edge * np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T
+        blocks = np.array([block for _, block in ends(scale)]).reshape(-1, 1, 3)
+        return (blocks + corners[None]).reshape(-1, 3)
+
+    legend = (LegendEntry("mechanism attachment", MECHANISM_COLOR, "block"),) if glyphs else ()
+    return Decoration(draw, points, legend)
 
 
 def _mechanism_glyphs(model, system, x, u):
@@ -100,16 +158,14 @@ def _mechanism_glyphs(model, system, x, u):
     return out
 
 
-def _draw_mechanisms(plotter, glyphs, scale, offset):
-    """Connector lines and blocks for each mechanism (pyvista actors)."""
-    if not glyphs:
+def _draw_mechanisms(plotter, ends, size: float, radius: float) -> None:
+    """A connector tube and a block (edge ``size``, m) per mechanism (pyvista actors)."""
+    if not ends:
         return
     import pyvista as pv
 
-    size = 0.4 * offset
-    for point, frame_u, d, body in glyphs:
-        base = point + scale * frame_u
-        block = point - offset * d + scale * body * d
-        plotter.add_mesh(pv.Line(base, block), color=MECHANISM_COLOR, line_width=3)
+    for base, block in ends:
+        plotter.add_mesh(pv.Line(base, block).tube(radius=radius, n_sides=12),
+                         color=MECHANISM_COLOR, smooth_shading=True)
         plotter.add_mesh(pv.Cube(center=block, x_length=size, y_length=size, z_length=size),
                          color=MECHANISM_COLOR, smooth_shading=False)

@@ -5,17 +5,24 @@ next to the page, so the folder can be moved or zipped as a whole. The page is w
 atomically (:func:`femmech.output.export.atomic_path`); :func:`write_report` refuses to
 write a page that references a missing file.
 
-Stage 6 (output): uses only output.export.
+Every number in a table cell is formatted by :func:`femmech.output.formatting.format_value`
+(engineering notation, fixed significant digits, no float artefacts); NaN and infinite
+values are highlighted like :class:`Flagged` cells.
+
+Stage 6 (output): uses output.export and output.formatting.
 """
 
 from __future__ import annotations
 
 import html
+import re
 from dataclasses import dataclass, field
+from numbers import Real
 from pathlib import Path
 from urllib.parse import quote
 
 from femmech.output.export import atomic_path
+from femmech.output.formatting import Quantity, format_value, is_flagged
 
 CSS = """
 body{font-family:system-ui,-apple-system,'Segoe UI',sans-serif;margin:0 auto;max-width:1100px;
@@ -24,8 +31,9 @@ h1{margin-bottom:.2em}h2{border-bottom:2px solid #3b6ea5;padding-bottom:.2em;mar
 .meta{color:#666;font-size:.9em}nav a{margin-right:1em}
 table{border-collapse:collapse;margin:.6em 0 1em;font-size:.88em}
 caption{caption-side:top;text-align:left;font-weight:600;padding:.3em 0}
-th,td{border:1px solid #ccd;padding:.25em .6em;text-align:right}
-th{background:#eef3f9}td:first-child,th:first-child{text-align:left}
+th,td{border:1px solid #ccd;padding:.25em .6em;text-align:left;vertical-align:top}
+th{background:#eef3f9}td.num{text-align:right;font-variant-numeric:tabular-nums;
+white-space:nowrap}
 figure{display:inline-block;margin:.5em 1em .5em 0;vertical-align:top}
 figure img{max-width:min(100%,720px);border:1px solid #dde}
 figcaption{font-size:.85em;color:#444}
@@ -38,7 +46,12 @@ td.flagged{background:#fdecea;color:#8b1a10;font-weight:600}
 
 @dataclass(frozen=True)
 class Table:
-    """A table: caption, header cells and rows of cells (str or numbers)."""
+    """A table: caption, header cells and rows of cells.
+
+    A cell is a str, an int, a float (4 significant digits), a
+    :class:`~femmech.output.formatting.Quantity` (value with unit and digits) or a
+    :class:`Flagged` text.
+    """
 
     caption: str
     header: tuple
@@ -70,6 +83,8 @@ class Section:
     warnings : tuple of str
         Findings the reader must not miss (unconverged results), shown highlighted
         before the tables.
+    preformatted : tuple of str
+        Lines shown as one preformatted block after the tables (a run log).
     """
 
     title: str
@@ -80,6 +95,7 @@ class Section:
     gallery: bool = False
     anchor: str = field(default="")
     warnings: tuple = ()
+    preformatted: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -89,20 +105,40 @@ class Flagged:
     text: str
 
 
+_NUMBER = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)(e[-+]?\d+)?( ?%| [^\s\d]+)?$")
+"""A cell's text that is a number, optionally with a unit: right-aligned."""
+
+
 def _cell(value) -> str:
+    """One ``<td>``: class ``flagged`` for Flagged, NaN and infinite values, class
+    ``num`` (right-aligned) for numbers."""
+    classes = []
+    if isinstance(value, Flagged) or (isinstance(value, Quantity) and value.flagged) \
+            or is_flagged(value):
+        classes.append("flagged")
+    text = _text(value)
+    if (isinstance(value, (Quantity, Real)) and not isinstance(value, bool)) or \
+            _NUMBER.match(html.unescape(text)):
+        classes.append("num")
+    attr = f' class="{" ".join(classes)}"' if classes else ""
+    return f"<td{attr}>{text}</td>"
+
+
+def _text(value) -> str:
     if isinstance(value, Flagged):
         return html.escape(value.text)
-    if isinstance(value, float):
-        return html.escape(f"{value:.6g}")
+    if isinstance(value, (Quantity, str)):
+        return html.escape(str(value))
+    if isinstance(value, Real) and not isinstance(value, bool):
+        return html.escape(format_value(value))
     return html.escape(str(value))
 
 
 def render_table(table: Table) -> str:
-    """HTML of one table."""
-    head = "".join(f"<th>{_cell(h)}</th>" for h in table.header)
-    body = "".join("<tr>" + "".join(
-        f'<td class="flagged">{_cell(c)}</td>' if isinstance(c, Flagged) else
-        f"<td>{_cell(c)}</td>" for c in row) + "</tr>" for row in table.rows)
+    """HTML of one table; numbers formatted by
+    :func:`~femmech.output.formatting.format_value`."""
+    head = "".join(f"<th>{_text(h)}</th>" for h in table.header)
+    body = "".join("<tr>" + "".join(_cell(c) for c in row) + "</tr>" for row in table.rows)
     return (f"<table><caption>{html.escape(table.caption)}</caption><thead><tr>{head}</tr>"
             f"</thead><tbody>{body}</tbody></table>")
 
@@ -122,6 +158,8 @@ def render_section(section: Section, anchor: str) -> str:
     if section.figures:
         cls = ' class="gallery"' if section.gallery else ""
         parts.append(f"<div{cls}>" + "".join(_figure(f) for f in section.figures) + "</div>")
+    if section.preformatted:
+        parts.append("<pre>" + html.escape("\n".join(section.preformatted)) + "</pre>")
     if section.files:
         links = "".join(f'<li><a href="{quote(f)}">{html.escape(f)}</a></li>'
                         for f in section.files)

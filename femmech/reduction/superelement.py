@@ -19,6 +19,7 @@ import scipy.sparse as sp
 
 from femmech.fe.dofs import DOF_PER_NODE, components, dof_label
 from femmech.fe.model import FEModel, node_indices
+from femmech.html import html_summary
 from femmech.reduction import superelement_file
 
 FORMAT_VERSION = superelement_file.FORMAT_VERSION
@@ -80,6 +81,16 @@ class Superelement:
         return (f"Superelement({self.method}: {self.n_reduced} coordinates ="
                 f" {self.n_interface} interface DOFs{modal}{residual}; full model"
                 f" {self.n_dof} DOFs)")
+
+    def _repr_html_(self) -> str:
+        f = self.modal_freq_hz
+        facts = [("method", self.method),
+                 ("interface DOFs", self.n_interface),
+                 ("modal coordinates", f"{self.n_modal} ({self.n_residual} residual vectors)"),
+                 ("full model DOFs", self.n_dof)]
+        if f.size:
+            facts.append(("fixed-interface modes / Hz", f"{f.min():.4g} … {f.max():.4g}"))
+        return html_summary(f"Superelement: {self.n_reduced} coordinates", facts)
 
     @property
     def n_interface(self) -> int:
@@ -168,7 +179,10 @@ def interface_dofs(model: FEModel, interface) -> np.ndarray:
     model : FEModel
     interface : str, int, or sequence of (str | int | (nodes, components))
         Group names or node indices (all six DOFs of each node), or pairs of a group/
-        node(s) and components (``("guide", ["uy", "uz"])``).
+        node(s) and components (``("guide", ["uy", "uz"])``). "All DOFs" (a bare group or
+        node, or the components ``"all"``) means the active ones: a node that only solid
+        elements use has translations only (its rotations are
+        :attr:`~femmech.fe.model.FEModel.inactive`), so its three translations are taken.
 
     Returns
     -------
@@ -177,18 +191,23 @@ def interface_dofs(model: FEModel, interface) -> np.ndarray:
     Raises
     ------
     ValueError
-        Naming the DOF if it is supported or the slave of a rigid link (not a free DOF).
+        Naming the DOF if it is supported or the slave of a rigid link (not a free DOF),
+        or a rotation of a solid-only node named explicitly (with what to write instead).
     """
     items = [interface] if isinstance(interface, (str, int, np.integer)) else list(interface)
     if not items:
         raise ValueError("the interface is empty: give node sets, nodes or (nodes, dofs)")
     dofs = []
     for item in items:
-        if isinstance(item, tuple) and len(item) == 2:
-            nodes, comps = node_indices(model.mesh, item[0], "interface"), components(item[1])
-        else:
-            nodes, comps = node_indices(model.mesh, item, "interface"), np.arange(DOF_PER_NODE)
-        dofs.append((DOF_PER_NODE * nodes[:, None] + comps).ravel())
+        ref, spec = item if isinstance(item, tuple) and len(item) == 2 else (item, "all")
+        nodes = node_indices(model.mesh, ref, "interface")
+        found = (DOF_PER_NODE * nodes[:, None] + components(spec)).ravel()
+        inactive = np.isin(found, model.inactive)
+        if isinstance(spec, str) and spec == "all":
+            found = found[~inactive]
+        elif inactive.any():
+            raise ValueError(_inactive_message(ref, int(found[inactive][0])))
+        dofs.append(found)
     dofs = np.unique(np.concatenate(dofs))
     position = np.searchsorted(model.free, dofs)
     position = np.minimum(position, model.free.size - 1)
@@ -199,3 +218,11 @@ def interface_dofs(model: FEModel, interface) -> np.ndarray:
                          " drop the support")
     return dofs
 
+
+def _inactive_message(ref, dof: int) -> str:
+    """Why an interface may not name the rotation ``dof`` of a solid-only node."""
+    return (f"interface {ref!r}: {dof_label(dof)} is a rotation of a node that only solid"
+            " elements use; solids have no rotational stiffness, so the model has no such"
+            f" DOF. Give the translations, ({ref!r}, 'translations') (in a scene: dofs ="
+            " \"translations\", or leave dofs out), or join the node to a beam or a rigid"
+            " link to carry rotations")

@@ -7,23 +7,48 @@ angle, :func:`femmech.analysis.sweep.sweep` or :func:`femmech.mechanisms.quasi_m
 ``response`` (:func:`femmech.analysis.response.periodic_steady_state` or a run-up by
 :func:`~femmech.analysis.response.time_response`) and ``check`` (reduced versus full,
 :func:`femmech.analysis.reference.compare_coupled`, optionally over several reduction
-sizes: the speed-versus-error comparison).
+sizes: the speed-versus-error comparison) and ``drive_event`` (a drive run up to speed,
+tripped when its force reaches a limit and braked to rest, for several braking times:
+:func:`femmech.analysis.drive_events.trip_and_brake` on a mechanism of form
+``second_kind``).
 
-Stage 7 (scene), reading: uses scene.reader, scene.units and the defaults of
-analysis.response and analysis.magnus.
+``speed_unit`` (a key of ``[analyses]`` itself: "rpm", the default, or "rad/s") is the
+one unit in which the scene's charts, tables and report show drive speeds; it is copied
+into the sweep, stability and response specs.
+
+Stage 7 (scene), reading: uses scene.reader, scene.units, scene.machine (what a built-in
+mechanism's coordinates are), the defaults of analysis.response and analysis.magnus,
+analysis.nonlinear (the integrators), analysis.drive_events (travel time) and
+output.charts (how a speed is labelled).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from femmech.analysis.drive_events import travel_time
 from femmech.analysis.magnus import MAX_STEPS as MONODROMY_MAX_STEPS
 from femmech.analysis.magnus import RTOL as MONODROMY_RTOL
+from femmech.analysis.nonlinear import METHODS as INTEGRATORS
 from femmech.analysis.response import STEADY_STATE_MAX_STEPS, STEADY_STATE_RTOL
+from femmech.errors import SceneError
+from femmech.output.charts import format_speed, speed_resolution
+from femmech.scene.machine import describe_quantity
 from femmech.scene.reader import Reader, show
-from femmech.scene.units import ANGLE, DIMENSIONLESS, FREQUENCY, INVERSE_TIME, SPEED, TIME
+from femmech.scene.units import (
+    ANGLE,
+    DIMENSIONLESS,
+    FORCE,
+    FREQUENCY,
+    INVERSE_TIME,
+    LENGTH,
+    LINEAR_SPEED,
+    MOMENT,
+    SPEED,
+    TIME,
+)
 
 MAX_MODES = 2000
 """Most modes a scene may ask for (``n_modes`` of a reduction or an analysis)."""
@@ -41,6 +66,22 @@ MAX_HISTORIES = 64
 MAX_LEVELS = 20
 """Most reduction sizes of the speed-versus-error comparison (``f_max_hz_levels``; each
 a full reduction and coupled solve)."""
+MAX_RUNS = 20
+"""Most braking times of a drive event (each a time integration)."""
+MAX_DRIVE_STEPS = 2**22
+"""Most steps of size ``max_step`` a drive event may need (its simulated time over
+``max_step``)."""
+MAX_DRIVE_EVALUATIONS = 1_000_000
+"""Most evaluations of the equations of motion in one drive event, all runs together
+(the crane example needs 4e4; a million take minutes): a run that needs more stops with
+an error instead of running for hours."""
+SPEED_UNITS = ("rpm", "rad/s")
+"""Units a scene may show drive speeds in (``[analyses] speed_unit``; the first is the
+default)."""
+
+
+MAX_ANIMATIONS = 12
+"""Most mode animations (GIF, about 1 s and 0.8 MB each) one modes analysis may ask for."""
 
 
 @dataclass(frozen=True)
@@ -53,6 +94,8 @@ class ModesSpec:
     model: str
     images: int
     vtu: bool
+    series: bool = False
+    animate: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -65,6 +108,7 @@ class SweepSpec:
     mechanism: str | None
     track: bool
     mode_images_at: tuple
+    speed_unit: str = "rpm"
 
 
 @dataclass(frozen=True)
@@ -78,6 +122,7 @@ class StabilitySpec:
     tol: float
     rtol: float
     max_steps: int
+    speed_unit: str = "rpm"
 
 
 @dataclass(frozen=True)
@@ -96,6 +141,7 @@ class ResponseSpec:
     rayleigh: tuple
     rtol: float
     max_steps: int
+    speed_unit: str = "rpm"
 
 
 @dataclass(frozen=True)
@@ -117,6 +163,8 @@ class Analyses:
     stability: StabilitySpec | None = None
     response: ResponseSpec | None = None
     check: CheckSpec | None = None
+    drive_event: DriveEventSpec | None = None
+    speed_unit: str = "rpm"
     where: dict = field(default_factory=dict, compare=False)
 
 
@@ -162,29 +210,48 @@ def _only_part(r: Reader, parts: dict) -> str:
     return part
 
 
-_KEYS = {"modes": ("part", "n_modes", "band_hz", "model", "images", "vtu"),
+_KEYS = {"modes": ("part", "n_modes", "band_hz", "model", "images", "vtu", "series",
+                   "animate"),
          "sweep": ("angles", "n_modes", "speeds", "mechanism", "track", "mode_images_at"),
          "stability": ("speeds", "n_steps", "angle_period", "rayleigh", "tol", "rtol",
                        "max_steps"),
          "response": ("kind", "speed", "n_steps", "speed_start", "speed_end", "duration",
                       "t_end", "outputs", "frame_dofs", "rayleigh", "rtol", "max_steps"),
-         "check": ("angles", "n_modes", "f_max_hz_levels")}
+         "check": ("angles", "n_modes", "f_max_hz_levels"),
+         "drive_event": ("mechanism", "drive", "start", "end", "t_max", "speed", "ramp_time",
+                         "trip_force", "braking_times", "time_after_stop", "outputs",
+                         "samples", "method", "rtol", "atol", "max_step", "verify")}
 """Keys of each analysis table."""
 
 
 def read_analyses(r: Reader, parts: dict, mechanisms: dict, has_mounts: bool) -> Analyses:
     """Parse ``[analyses]``; checks that each analysis has what it needs."""
-    r.expect(*_READERS)
+    r.expect("speed_unit", *_READERS)
+    unit = r.string("speed_unit", SPEED_UNITS[0], choices=SPEED_UNITS)
     out, where = {}, {}
     readers = {k: r.table(k) for k in _READERS if r.has(k)}
     for kind, t in readers.items():
         t.expect(*_KEYS[kind])
         where[kind] = t.where
         out[kind] = _READERS[kind](t, parts, mechanisms, has_mounts)
+        if kind in ("sweep", "stability", "response"):
+            out[kind] = replace(out[kind], speed_unit=unit)
     if not out:
         raise r.error(None, "no analyses requested: add [analyses.modes], [analyses.sweep],"
-                            " [analyses.stability], [analyses.response] or [analyses.check]")
-    return Analyses(**out, where=where)
+                            " [analyses.stability], [analyses.response], [analyses.check]"
+                            " or [analyses.drive_event]")
+    if "sweep" in out:
+        _distinct_labels(readers["sweep"], out["sweep"].speeds, unit)
+    return Analyses(**out, speed_unit=unit, where=where)
+
+
+def _distinct_labels(t: Reader, speeds: tuple, unit: str) -> None:
+    """Each curve of a sweep is labelled by its speed in ``unit``: no two labels alike."""
+    labels = [format_speed(W, unit) for W in speeds]
+    twice = [s for i, s in enumerate(labels) if s in labels[:i]]
+    if twice:
+        raise t.error("speeds", f"two speeds round to {twice[0]}; each curve of a sweep is"
+                                f" labelled by its speed in {speed_resolution(unit)}")
 
 
 def _n_modes(t: Reader, default=None, minimum: int = 1):
@@ -208,7 +275,15 @@ def _modes(t: Reader, parts, mechanisms, has_mounts) -> ModesSpec:
         raise t.error("model", f"part {part!r} has no [reduction]; use model = 'full'")
     images = t.integer("images", min(n_modes or 6, 6), minimum=0, maximum=MAX_IMAGES,
                        limit="MAX_IMAGES")
-    return ModesSpec(part, n_modes, band, model, images, t.boolean("vtu", True))
+    animate = t.get("animate", [])
+    if not (isinstance(animate, list) and all(isinstance(k, int) and not isinstance(k, bool)
+                                              and k >= 1 for k in animate)):
+        raise t.error("animate", "expected a list of mode numbers (1 = the lowest mode), got"
+                                 f" {show(animate)}")
+    if len(set(animate)) > MAX_ANIMATIONS:
+        raise t.error("animate", f"at most {MAX_ANIMATIONS} animations (MAX_ANIMATIONS)")
+    return ModesSpec(part, n_modes, band, model, images, t.boolean("vtu", True),
+                     t.boolean("series", False), tuple(sorted(set(animate))))
 
 
 def _needs_machine(t: Reader, parts, has_mounts, what: str) -> None:
@@ -226,6 +301,10 @@ def _sweep(t: Reader, parts, mechanisms, has_mounts) -> SweepSpec:
     if mechanism is not None and mechanism not in mechanisms:
         raise t.error("mechanism", f"expected one of the [mechanisms] {sorted(mechanisms)},"
                                    f" got {show(mechanism)}")
+    if mechanism is not None and mechanisms[mechanism].form != "rheolinear":
+        raise t.error("mechanism", f"mechanism {mechanism!r} has form ="
+                                   f" {mechanisms[mechanism].form!r}; quasi-modes need form ="
+                                   " 'rheolinear' (the default)")
     if mechanism is None:
         _needs_machine(t, parts, has_mounts, "a sweep of the machine (no mechanism key)")
     angles = _values(t, "angles", ANGLE, (0.0, 2 * np.pi))
@@ -235,11 +314,6 @@ def _sweep(t: Reader, parts, mechanisms, has_mounts) -> SweepSpec:
                                         " mechanism alone, not an assembly of parts)")
     n_modes = _n_modes(t, 6)
     speeds = _values(t, "speeds", SPEED, (0.0,))
-    rpm = [round(W * 30 / np.pi) for W in speeds]
-    twice = [r for i, r in enumerate(rpm) if r in rpm[:i]]
-    if twice:
-        raise t.error("speeds", f"two speeds round to {twice[0]} rpm; each curve of a sweep is"
-                                " labelled by its speed in whole rpm")
     if len(angles) * len(speeds) > MAX_SWEEP_POINTS:
         raise t.error("speeds", f"{len(angles)} angles x {len(speeds)} speeds; at most"
                                 f" {MAX_SWEEP_POINTS} points (limit MAX_SWEEP_POINTS)")
@@ -311,5 +385,117 @@ def _check(t: Reader, parts, mechanisms, has_mounts) -> CheckSpec:
     return CheckSpec(angles, _n_modes(t, 6), levels)
 
 
+@dataclass(frozen=True)
+class DriveEventSpec:
+    """A drive run up to speed, tripped when its force reaches ``trip_force``, braked to
+    rest in each of ``braking_times`` (:func:`femmech.analysis.drive_events.trip_and_brake`).
+
+    SI units; positions, speeds and forces of a translational drive in m, m/s, N, of a
+    rotational one (``rotational``) in rad, rad/s, N·m. ``outputs`` None: all free
+    coordinates; ``max_step`` None: no limit.
+    """
+
+    mechanism: str
+    drive: str
+    rotational: bool
+    start: float
+    end: float | None
+    t_max: float | None
+    speed: float
+    ramp_time: float
+    trip_force: float
+    braking_times: tuple
+    time_after_stop: float
+    outputs: tuple | None
+    samples: int
+    method: str
+    rtol: float
+    atol: float
+    max_step: float | None
+    verify: bool
+
+
+def _second_kind_mechanism(t: Reader, mechanisms: dict) -> str:
+    """The ``mechanism`` key (default: the only one of form second_kind), checked."""
+    candidates = sorted(n for n, m in mechanisms.items() if m.form == "second_kind")
+    name = t.string("mechanism", candidates[0] if len(candidates) == 1 else None)
+    if name not in mechanisms:
+        raise t.error("mechanism", f"expected one of the [mechanisms] {sorted(mechanisms)},"
+                                   f" got {show(name)}")
+    if mechanisms[name].form != "second_kind":
+        raise t.error("mechanism", f"a drive event needs the nonlinear equations: set form ="
+                                   f" 'second_kind' in [mechanisms.{name}]")
+    return name
+
+
+def _is_rotational(t: Reader, spec, drive: str) -> bool:
+    """Whether the drive is an angle: from a built-in model's drive force (a force or a
+    moment), else from the unit of ``start``."""
+    kind = describe_quantity(spec, f"force {drive}")[1]
+    if kind in (FORCE, MOMENT):
+        return kind is MOMENT
+    fits = []
+    for kind in (LENGTH, ANGLE):
+        try:
+            t.number("start", kind)
+            fits.append(kind)
+        except SceneError:
+            pass
+    if len(fits) != 1:
+        raise t.error("start", f"expected a length or an angle with its unit (e.g. '4.7 m' or"
+                               f" '30 deg': the dimension of drive {drive!r} is not known"
+                               f" otherwise), got {show(t.get('start'))}")
+    return fits[0] is ANGLE
+
+
+def _drive_event(t: Reader, parts, mechanisms, has_mounts) -> DriveEventSpec:
+    mechanism = _second_kind_mechanism(t, mechanisms)
+    drive = t.string("drive")
+    rotational = _is_rotational(t, mechanisms[mechanism], drive)
+    position = ANGLE if rotational else LENGTH
+    start, end = t.number("start", position), t.number("end", position, None)
+    speed = t.number("speed", SPEED if rotational else LINEAR_SPEED)
+    if speed == 0:
+        raise t.error("speed", "expected a non-zero drive speed (its sign is the direction)")
+    if end is not None and not (end - start) * speed > 0:
+        raise t.error("end", f"expected the end of travel in the direction of the speed"
+                             f" ({speed:g}) from start ({start:g}), got {end:g} (SI units)")
+    t_max = t.number("t_max", TIME, None, positive=True)
+    if end is None and t_max is None:
+        raise t.error(None, "give end (the end of travel) or t_max (the latest trip time):"
+                            " the run stops there if the force never reaches trip_force")
+    ramp = t.number("ramp_time", TIME, positive=True)
+    force = t.number("trip_force", MOMENT if rotational else FORCE)
+    if force == 0:
+        raise t.error("trip_force", "expected a non-zero force (a positive limit is reached"
+                                    " from below, a negative one from above)")
+    brakes = _values(t, "braking_times", TIME, maximum=MAX_RUNS, limit="MAX_RUNS")
+    if brakes is None or min(brakes) <= 0:
+        raise t.error("braking_times", "expected a list of positive braking times, e.g."
+                                       " ['0.2 s', '0.5 s']")
+    after = t.number("time_after_stop", TIME, 0.0, non_negative=True)
+    outputs = t.strings("outputs", None)
+    if outputs is not None and (len(outputs) > MAX_HISTORIES or len(set(outputs))
+                                < len(outputs)):
+        raise t.error("outputs", f"expected at most {MAX_HISTORIES} distinct names (limit"
+                                 f" MAX_HISTORIES), got {show(list(outputs))}")
+    rtol = t.number("rtol", DIMENSIONLESS, 1e-10, positive=True)
+    if not rtol < 1:
+        raise t.error("rtol", f"expected a relative tolerance below 1, got {rtol:g}")
+    max_step = t.number("max_step", TIME, None, positive=True)
+    longest = min(travel_time(start, end, speed, ramp) if end is not None else np.inf,
+                  t_max or np.inf) + max(brakes) + after
+    if max_step is not None and longest / max_step > MAX_DRIVE_STEPS:
+        raise t.error("max_step", f"{longest:.6g} s in steps of {max_step:g} s; at most"
+                                  f" {MAX_DRIVE_STEPS} steps (limit MAX_DRIVE_STEPS)")
+    return DriveEventSpec(mechanism, drive, rotational, start, end, t_max, speed, ramp, force,
+                          brakes, after, outputs,
+                          t.integer("samples", 1500, minimum=2, maximum=MAX_POINTS,
+                                    limit="MAX_POINTS"),
+                          t.string("method", "DOP853", choices=tuple(INTEGRATORS)), rtol,
+                          t.number("atol", DIMENSIONLESS, 1e-12, positive=True), max_step,
+                          t.boolean("verify", False))
+
+
 _READERS = {"modes": _modes, "sweep": _sweep, "stability": _stability, "response": _response,
-            "check": _check}
+            "check": _check, "drive_event": _drive_event}

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from femmech.coupling import Attachment, Mount
-from femmech.errors import ModelWarning, UserCodeError
+from femmech.errors import ModelWarning, UserCodeError, did_you_mean, name_list
 from femmech.fe import sections as sec
 from femmech.fe.constraints import InterpolatingLink, RigidLink, Support
 from femmech.fe.dofs import COMPONENTS
@@ -49,7 +49,7 @@ from femmech.fe.sections import BeamSection
 from femmech.reduction.component_modes import CUTOFF_FACTOR, craig_bampton, guyan
 from femmech.reduction.superelement import FORMAT_VERSION
 from femmech.scene.load import PartSpec, Scene, fail
-from femmech.scene.mechanisms import confined_module, mechanism_model
+from femmech.scene.mechanisms import check_drive_event, confined_module, mechanism_model
 from femmech.version import __version__
 
 _ITEMS = {"support": Support, "mass": PointMass, "spring": Spring,
@@ -122,6 +122,7 @@ def prepare(scene: Scene, allow_code: bool = False, code_root=None,
         _check_mount(scene, mount, meshes[mount.part], models.get(mount.mechanism))
     if len(models) == len(scene.mechanisms):
         _check_outputs(scene, models)
+    check_drive_event(scene, models)
     keys = {name: sha256_key(reduction_key_data(scene, part))
             for name, part in scene.parts.items() if part.reduction is not None}
     findings = {name: part_findings(scene, part, meshes[name])
@@ -224,7 +225,8 @@ def check_part(scene: Scene, part: PartSpec, mesh: Mesh) -> None:
     for prop in (*part.sections, *part.shells, *part.solids):
         if prop.group not in mesh.cell_sets:
             raise fail(scene, prop.where, None, f"group {prop.group!r} is not a cell group of"
-                       f" the mesh; expected one of {sorted(mesh.cell_sets)}")
+                       f" the mesh; expected one of {name_list(mesh.cell_sets)}"
+                       f"{did_you_mean(prop.group, mesh.cell_sets)}")
     lines = mesh.cells.get("line", np.empty((0, 2)))
     owned = np.zeros(len(lines), dtype=bool)
     for prop in part.sections:
@@ -324,7 +326,7 @@ def _model_args(scene: Scene, part: PartSpec) -> dict:
     for s in part.sections:
         section = _section(s)
         beams[s.group] = BeamProperty(section, mats[s.material], s.orientation, s.shear,
-                                         s.rotary_inertia)
+                                         s.rotary_inertia, s.orientation_plane)
     for s in part.shells:
         shells[s.group] = ShellProperty(s.thickness, mats[s.material])
     for s in part.solids:

@@ -52,7 +52,8 @@ SECTION_SHAPES = {
 GENERAL_OPTIONAL = (("Asy", AREA), ("Asz", AREA), ("Ip", SECOND_MOMENT))
 REDUCTIONS = ("guyan", "craig_bampton")
 _SPRING_KINDS = (STIFFNESS,) * 3 + (ROT_STIFFNESS,) * 3
-_SECTION_KEYS = ("section", "material", "orientation", "shear", "rotary_inertia")
+_SECTION_KEYS = ("section", "material", "orientation", "orientation_plane", "shear",
+                 "rotary_inertia")
 _DIMENSION_KEYS = tuple(dict.fromkeys(
     key for dims in (*SECTION_SHAPES.values(), GENERAL_OPTIONAL) for key, _ in dims))
 _PART_KEYS = ("mesh", "generator", "edge_node_groups", "merge_nodes", "sections", "shells",
@@ -81,6 +82,7 @@ class SectionSpec:
     shear: bool = True
     rotary_inertia: bool = True
     where: str = field(default="", compare=False)
+    orientation_plane: str = "xy"
 
 
 @dataclass(frozen=True)
@@ -257,10 +259,13 @@ def _section(group: str, r: Reader, materials: dict) -> SectionSpec:
     _check_dimensions(r, shape, dict(dims))
     material = _material_name(r, materials)
     orientation = r.vector("orientation", (DIMENSIONLESS,) * 3, None)
+    plane = r.string("orientation_plane", "xy", choices=("xy", "xz"))
     if orientation is not None and not any(orientation):
-        raise r.error("orientation", "expected a non-zero vector (the local y axis)")
+        raise r.error("orientation", f"expected a non-zero vector (in the local {plane[0]}-"
+                                     f"{plane[1]} plane)")
     return SectionSpec(group, shape, tuple(dims), material, orientation,
-                       r.boolean("shear", True), r.boolean("rotary_inertia", True), r.where)
+                       r.boolean("shear", True), r.boolean("rotary_inertia", True), r.where,
+                       plane)
 
 
 def _check_dimensions(r: Reader, shape: str, dims: dict) -> None:

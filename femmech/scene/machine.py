@@ -3,8 +3,11 @@
 A mechanism is a built-in model of :mod:`femmech.mechanisms` (:data:`BUILTIN_MODELS`) or a
 function in a user Python module (``module = "my_mech.py"``, ``function = "build"``)
 returning a symbolic :class:`~femmech.mechanisms.Mechanism` (or a ready
-``RheolinearModel``), with parameter values (SI or unit strings) and position functions
-(cams, linkages). A mount places a mechanism on a part: :class:`femmech.coupling.Mount`.
+``RheolinearModel`` or ``LagrangeModel``), with parameter values (SI or unit strings) and
+position functions (cams, linkages). Its ``form`` (:data:`FORMS`) says which equations
+are built: ``rheolinear`` (the default; mounts, sweeps) or ``second_kind`` (the nonlinear
+equations with prescribed drives; drive events). A mount places a mechanism on a part:
+:class:`femmech.coupling.Mount`.
 
 Stage 7 (scene), reading: uses scene.reader, scene.units, fe.dofs and the factories of
 mechanisms; nothing is built here.
@@ -18,9 +21,16 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from femmech.fe.dofs import COMPONENTS
-from femmech.mechanisms import cam_follower, processing_machine, slider_crank, table_5_1_case
+from femmech.mechanisms import (
+    cam_follower,
+    mobile_crane,
+    processing_machine,
+    slider_crank,
+    table_5_1_case,
+)
 from femmech.scene.reader import Reader, show
 from femmech.scene.units import (
+    ACCELERATION,
     ANGLE,
     DAMPING,
     DIMENSIONLESS,
@@ -32,10 +42,12 @@ from femmech.scene.units import (
     ROT_DAMPING,
     ROT_STIFFNESS,
     STIFFNESS,
+    Kind,
 )
 
 BUILTIN_MODELS = {"cam_follower": cam_follower, "slider_crank": slider_crank,
-                  "table_5_1_case": table_5_1_case, "processing_machine": processing_machine}
+                  "table_5_1_case": table_5_1_case, "processing_machine": processing_machine,
+                  "mobile_crane": mobile_crane}
 """Built-in mechanism models by scene name → factory of :mod:`femmech.mechanisms`;
 ``options`` are the factory's keyword arguments (checked against its signature). To offer
 a new mechanism type in scenes, add its factory here (and its roles to ``_ROLE_KINDS``)."""
@@ -59,8 +71,35 @@ _NAMED_KINDS = {
                            "c4": STIFFNESS, "c6": STIFFNESS, "c7": STIFFNESS,
                            "bT1": ROT_DAMPING, "bT2": ROT_DAMPING, "b3": DAMPING, "b4": DAMPING,
                            "F1": FORCE, "F2": FORCE, "M0": MOMENT},
+    "mobile_crane": {"m2": MASS, "m3": MASS, "m5": MASS, "JS2": INERTIA, "JS3": INERTIA,
+                     "JS5": INERTIA, "x23": LENGTH, "xi23": LENGTH, "eta23": LENGTH,
+                     "rS3": LENGTH, "rS5": LENGTH, "r24": LENGTH, "r34": LENGTH,
+                     "r25": LENGTH, "alpha": ANGLE, "gamma": ANGLE, "c": STIFFNESS,
+                     "l1": LENGTH, "l2": LENGTH, "g": ACCELERATION},
 }
 """Dimensions of parameters with fixed names (others accept any unit, converted to SI)."""
+
+FORMS = ("rheolinear", "second_kind")
+"""Equations a scene builds for a mechanism (``form``): ``rheolinear`` (linearised about
+the programmed drive motion, :func:`femmech.mechanisms.rheolinear`; for mounts and
+sweeps; the default) or ``second_kind`` (the nonlinear Lagrange equations of the 2nd kind
+with prescribed drives, :func:`femmech.mechanisms.second_kind`; for drive events)."""
+
+QUANTITIES = {
+    "mobile_crane": {"q1": ("chassis heave", LENGTH), "q2": ("chassis pitch", ANGLE),
+                     "q3": ("pendulum angle", ANGLE), "q4": ("cylinder length", LENGTH),
+                     "force q4": ("cylinder force", FORCE),
+                     "spring1": ("front axle force", FORCE),
+                     "spring2": ("rear axle force", FORCE)},
+    "processing_machine": {"q1": ("drive shaft angle", ANGLE), "q2": ("shaft twist 1", ANGLE),
+                           "q3": ("shaft twist 2", ANGLE),
+                           "q4": ("follower 1 deformation", LENGTH),
+                           "q5": ("follower 2 deformation", LENGTH),
+                           "force q1": ("drive torque", MOMENT)},
+}
+"""Per built-in model: quantity → (what it is physically, its dimension). Quantities are
+coordinate names, ``"force <drive>"`` (the force a drive supplies) and ``"spring<k>"``
+(the force of the k-th spring, 1-based in the mechanism's element order)."""
 
 POSITION_KINDS = ("cam", "slider_crank", "four_bar", "chapter_cam")
 MOTION_LAWS = ("polynomial_345", "cycloidal", "harmonic", "modified_sine", "modified_trapezoid")
@@ -88,6 +127,14 @@ class MechanismSpec:
     parameters: dict
     position_functions: tuple
     where: str = field(default="", compare=False)
+    form: str = "rheolinear"
+
+
+def describe_quantity(spec: MechanismSpec, name: str) -> tuple[str, Kind | None]:
+    """(physical description, dimension or None) of a quantity of a mechanism (see
+    :data:`QUANTITIES`); without a description the name itself, and None when the
+    dimension is unknown (a user module's coordinates)."""
+    return QUANTITIES.get(spec.model, {}).get(name, (name, None))
 
 
 @dataclass(frozen=True)
@@ -129,7 +176,8 @@ def read_mechanisms(root: Reader, base: Path) -> dict:
     """All ``[mechanisms.<name>]`` tables → {name: MechanismSpec}."""
     out = {}
     for name, r in root.named_tables("mechanisms").items():
-        r.expect("model", "module", "function", "options", "parameters", "position_functions")
+        r.expect("model", "module", "function", "options", "parameters", "position_functions",
+                 "form")
         if r.has("model") == r.has("module"):
             raise r.error(None, "give exactly one of model (built-in: one of"
                                 f" {list(BUILTIN_MODELS)}) and module (a Python file)")
@@ -147,7 +195,7 @@ def read_mechanisms(root: Reader, base: Path) -> dict:
         params = {key: p.number(key, kinds.get(key)) for key in p.data}
         funcs = tuple(_position(n, t) for n, t in r.named_tables("position_functions").items())
         out[name] = MechanismSpec(name, model, module, function, dict(options), params, funcs,
-                                  r.where)
+                                  r.where, r.string("form", FORMS[0], choices=FORMS))
     return out
 
 
@@ -246,6 +294,10 @@ def read_mounts(root: Reader, parts: dict, mechanisms: dict) -> tuple:
         if mech not in mechanisms:
             raise r.error("mechanism", f"expected one of the [mechanisms] {sorted(mechanisms)},"
                                        f" got {mech!r}")
+        if mechanisms[mech].form != "rheolinear":
+            raise r.error("mechanism", f"mechanism {mech!r} has form ="
+                                       f" {mechanisms[mech].form!r}; a mounted mechanism needs"
+                                       " form = 'rheolinear' (the default)")
         default_part = next(iter(parts)) if len(parts) == 1 else None
         part = r.string("part", default_part)
         if part not in parts:

@@ -1,4 +1,5 @@
-"""Mechanism models of a scene: built-in factories or user modules → RheolinearModel.
+"""Mechanism models of a scene: built-in factories or user modules → RheolinearModel
+(``form = "rheolinear"``) or LagrangeModel (``form = "second_kind"``).
 
 A user module (``module = "my_mech.py"``) is Python code: it runs only when the caller
 opts in (``allow_code=True``, ``femmech run --allow-code``), and only from a file inside
@@ -19,9 +20,11 @@ from femmech.mechanisms import (
     CamProfile,
     CamSegment,
     FourBar,
+    LagrangeModel,
     Mechanism,
     RheolinearModel,
     SliderCrank,
+    Spring,
     cycloidal,
     harmonic,
     modified_sine,
@@ -29,6 +32,7 @@ from femmech.mechanisms import (
     polynomial_345,
     processing_machine_cams,
     rheolinear,
+    second_kind,
 )
 from femmech.scene.load import fail
 from femmech.scene.machine import BUILTIN_MODELS
@@ -37,8 +41,14 @@ LAWS = {"polynomial_345": polynomial_345, "cycloidal": cycloidal, "harmonic": ha
         "modified_sine": modified_sine, "modified_trapezoid": modified_trapezoid}
 
 
-def mechanism_model(scene, spec, code_root=None) -> RheolinearModel:
-    """The rheolinear model of a :class:`~femmech.scene.machine.MechanismSpec`.
+FORM_BUILDERS = {"rheolinear": (rheolinear, RheolinearModel),
+                 "second_kind": (second_kind, LagrangeModel)}
+"""``form`` → (builder from a symbolic Mechanism, the model class it returns)."""
+
+
+def mechanism_model(scene, spec, code_root=None) -> RheolinearModel | LagrangeModel:
+    """The model of a :class:`~femmech.scene.machine.MechanismSpec` in its ``form``:
+    a RheolinearModel (``rheolinear``) or a LagrangeModel (``second_kind``).
 
     A user module is imported and its function called: the caller has checked the opt-in
     (:func:`femmech.scene.build.prepare`); its file must lie under ``code_root`` (default:
@@ -66,19 +76,39 @@ def mechanism_model(scene, spec, code_root=None) -> RheolinearModel:
         except Exception as exc:  # any failure of user code is reported at its location
             raise code_error(scene, spec, "function", f"the user code raised"
                              f" {type(exc).__name__}: {exc}") from None
-    if isinstance(built, RheolinearModel):
+    return _in_form(scene, spec, built)
+
+
+def _in_form(scene, spec, built):
+    """The model of the spec's form from what the factory or user function returned."""
+    build, cls = FORM_BUILDERS[spec.form]
+    if isinstance(built, (RheolinearModel, LagrangeModel)):
+        if not isinstance(built, cls):
+            raise fail(scene, spec.where, "form", f"the function returned a ready"
+                       f" {type(built).__name__}, not the {cls.__name__} of form ="
+                       f" {spec.form!r}; return a symbolic Mechanism or change form")
         if spec.parameters or spec.position_functions:
-            raise fail(scene, spec.where, "parameters", "the function returned a ready"
-                       " RheolinearModel: give no parameters or position_functions")
+            raise fail(scene, spec.where, "parameters", f"the function returned a ready"
+                       f" {cls.__name__}: give no parameters or position_functions")
         return built
     if not isinstance(built, Mechanism):
         raise fail(scene, spec.where, "function" if spec.module else "model",
-                   f"expected a Mechanism or RheolinearModel, got {type(built).__name__}")
+                   f"expected a Mechanism or {cls.__name__}, got {type(built).__name__}")
     funcs = {p.name: position_function(scene, p) for p in spec.position_functions}
     try:
-        return rheolinear(built, spec.parameters, funcs)
+        return build(built, spec.parameters, funcs)
     except (ValueError, TypeError, KeyError, AttributeError) as exc:
         raise fail(scene, spec.where, "parameters", str(exc).strip("'\"")) from None
+
+
+def coordinate_names(model) -> tuple[str, ...]:
+    """Names of a model's coordinates for tables: the vibration coordinates of a
+    RheolinearModel; all coordinates of a LagrangeModel, drives marked ``(drive)``."""
+    if isinstance(model, LagrangeModel):
+        drives = set(model.mechanism.drives)
+        return tuple(q.name + (" (drive)" if q in drives else "")
+                     for q in model.mechanism.coordinates)
+    return tuple(model.coordinate_names)
 
 
 def position_function(scene, p):
@@ -127,3 +157,29 @@ def load_module(path):
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def output_names(model: LagrangeModel) -> tuple[str, ...]:
+    """What a drive event of ``model`` can show: its coordinates and ``spring<k>``, the
+    force of its k-th spring (1-based, element order)."""
+    springs = sum(isinstance(el, Spring) for el in model.mechanism.elements)
+    return (tuple(q.name for q in model.mechanism.coordinates)
+            + tuple(f"spring{k + 1}" for k in range(springs)))
+
+
+def check_drive_event(scene, models: dict) -> None:
+    """The drive and outputs of ``[analyses.drive_event]`` against the built mechanism
+    (skipped when its user code was not run)."""
+    spec = scene.analyses.drive_event
+    if spec is None or spec.mechanism not in models:
+        return
+    model, where = models[spec.mechanism], scene.analyses.where["drive_event"]
+    drives = [x.name for x in model.mechanism.drives]
+    if spec.drive not in drives:
+        raise fail(scene, where, "drive", f"expected one of the drive coordinates {drives}"
+                   f" of mechanism {spec.mechanism!r}, got {spec.drive!r}")
+    allowed = output_names(model)
+    for name in spec.outputs or ():
+        if name not in allowed:
+            raise fail(scene, where, "outputs", f"expected coordinates or spring forces of"
+                       f" mechanism {spec.mechanism!r}, one of {list(allowed)}, got {name!r}")

@@ -36,7 +36,8 @@ from femmech.scene.build import (
 )
 from femmech.scene.cache_folder import default_cache_dir
 from femmech.scene.load import Scene, load_scene
-from femmech.scene.tasks import TASKS, summary_section
+from femmech.scene.summary import appendix_section, summary_section
+from femmech.scene.tasks import TASKS
 from femmech.scene.workshop import Workshop, progress
 from femmech.version import __version__
 
@@ -141,18 +142,20 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
             sections.append(section)
             results[kind] = numbers
             emit(f"{kind}: done in {ws.timings[f'analysis {kind}']:.2f} s")
+        with ws.timed("model summary"), logged_warnings(emit, "model summary"):
+            sections.insert(0, summary_section(ws))
         ws.timings["total"] = time.perf_counter() - start
         LOG.debug("timings (s): " + ", ".join(f"{k} {v:.3f}" for k, v in ws.timings.items()))
-        sections.insert(0, summary_section(ws))
         _write_json(stage / "results.json", results)
         sections.append(Section("Files", files=("results.json", "run.log")))
         emit(f"report: {final / 'report.html'}")
         with atomic_path(stage / "run.log") as tmp:
             tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        sections.append(appendix_section(ws, final, lines))
         meta = (f"scene {scene.file} · femmech {__version__} ·"
                 f" {time.strftime('%Y-%m-%d %H:%M')} · {ws.timings['total']:.1f} s")
         title = scene.name + (f" — {scene.description}" if scene.description else "")
-        report = write_report(stage, title, meta, sections, lines)
+        report = write_report(stage, title, meta, sections)
     return RunResult(final, final / report.name, results, tuple(lines), dict(ws.timings))
 
 

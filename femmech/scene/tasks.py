@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from femmech.analysis.drive_events import spring_forces, trip_and_brake
 from femmech.analysis.modes import modes, superelement_modes
 from femmech.analysis.reference import Comparison, compare_coupled
 from femmech.analysis.response import (
@@ -34,16 +35,22 @@ from femmech.analysis.sweep import sweep
 from femmech.coupling import couple
 from femmech.errors import ConvergenceWarning
 from femmech.fe.model import node_index
-from femmech.mechanisms import plot_quasi_frequencies, quasi_modes
+from femmech.mechanisms import Spring, quasi_modes
 from femmech.output import export_modes_vtu, frequency_table, plot_mac, write_frequency_csv
+from femmech.output.charts import format_speed, needs_log_scale, set_angle_axis, speed_scale
 from femmech.output.export import atomic_path
+from femmech.output.formatting import Quantity, format_value
+from femmech.output.histories import plot_event_histories, write_history_csv
 from femmech.output.report import Figure, Flagged, Section, Table
+from femmech.output.series import write_mode_series
 from femmech.output.stability_charts import plot_stability_chart
+from femmech.output.sweeps import plot_quasi_frequencies
+from femmech.scene.analyses import MAX_DRIVE_EVALUATIONS
 from femmech.scene.build import machine_mounts
-from femmech.scene.workshop import progress, timings_table
-
-RPM = 60.0 / (2 * math.pi)
-"""rad/s → rpm."""
+from femmech.scene.machine import describe_quantity, parameter_kinds
+from femmech.scene.summary import participation_tables
+from femmech.scene.units import ANGLE, FORCE, LENGTH, MOMENT, ROT_STIFFNESS, STIFFNESS
+from femmech.scene.workshop import progress
 
 
 def _list(a) -> list:
@@ -64,49 +71,10 @@ def _write_csv(path, header, rows) -> None:
         tmp.write_text(buffer.getvalue(), encoding="utf-8")
 
 
-def summary_section(ws) -> Section:
-    """Model summary: DOFs before and after reduction, modes kept, cache, timings."""
-    scene, rows = ws.scene, []
-    for name, part in scene.parts.items():
-        mesh = ws.prepared.meshes[name]
-        model = ws.models.get(name)
-        se = ws.superelements.get((name, None))
-        n_free = model.n_free if model is not None else (
-            len(se.free_interface) + len(se.free_interior) if se is not None else "-")
-        red = part.reduction
-        rows.append((name, mesh.n_nodes, 6 * mesh.n_nodes, n_free,
-                     red.method if red else "none",
-                     se.n_interface if se is not None else "-",
-                     se.n_modal - se.n_residual if se is not None else "-",
-                     se.n_residual if se is not None else "-",
-                     se.n_reduced if se is not None else "-",
-                     ws.cache_status.get(f"part {name!r}", "-")))
-    tables = [Table("Parts", ("part", "nodes", "DOFs", "free DOFs", "reduction",
-                              "interface DOFs", "modes kept", "residual vectors",
-                              "reduced coordinates", "cache"), tuple(rows))]
-    if scene.mounts:
-        mrows = tuple((m.name, m.mechanism, m.part,
-                       ", ".join(ws.prepared.mechanisms[m.mechanism].coordinate_names),
-                       ", ".join(f"{a.coordinate}→{a.node}:{a.direction}"
-                                 if isinstance(a.direction, str) else
-                                 f"{a.coordinate}→{a.node}" for a in m.attachments))
-                      for m in scene.mounts)
-        tables.append(Table("Mechanisms mounted", ("mount", "mechanism", "part", "coordinates",
-                                                   "attachments"), mrows))
-    text = []
-    machine = ws.machines.get(False)
-    if machine is not None:
-        text.append(f"Coupled machine: {machine.n} coordinates ({machine.n_frame} frame,"
-                    f" {machine.n - machine.n_frame} mechanism).")
-    full = ws.machines.get(True)
-    if full is not None:
-        text.append(f"Unreduced coupled machine (for the check): {full.n} coordinates.")
-    return Section("Model summary", tuple(text), tuple(tables) + (timings_table(ws),))
-
-
 def run_modes(ws, spec, out):
     """Natural modes of a part (full FE model or its superelement)."""
-    model = ws.model(spec.part) if (spec.model == "full" or spec.images or spec.vtu) else None
+    drawn = spec.images or spec.vtu or spec.series or spec.animate
+    model = ws.model(spec.part) if (spec.model == "full" or drawn) else None
     with ws.timed("eigen solve"):
         if spec.model == "full":
             result = modes(model, n_modes=spec.n_modes, band_hz=spec.band_hz)
@@ -120,25 +88,43 @@ def run_modes(ws, spec, out):
     if spec.vtu:
         export_modes_vtu(model, result, out / "modes.vtu")
         files.append("modes.vtu")
+    if spec.series:
+        write_mode_series(model, result, out / "modes.pvd")
+        files.append("modes.pvd")  # with its folder modes_steps/
     figures = []
+    for k in spec.animate:  # 1-based mode numbers; those beyond the computed set: noted
+        if k > result.n_modes:
+            ws.log(f"modes: animate mode {k}: only {result.n_modes} modes were computed")
+            continue
+        from femmech.output.animate import animate_mode
+
+        with ws.timed("mode animations"):
+            path = animate_mode(model, result, k - 1, out / f"mode_{k:02d}.gif")
+        figures.append(Figure(path.name, f"mode {k}: {result.freq_hz[k - 1]:.3f} Hz, moving"
+                                         " through one period (slowed down)"))
     if spec.images:
-        from femmech.output import plot_mode
+        from femmech.output import plot_modes
 
         n = min(spec.images, result.n_modes)
-        with ws.timed("mode images"):
-            paths = [plot_mode(model, result, i, out / f"mode_{i + 1:02d}.png")
-                     for i in progress(range(n), "mode images", ws.bars)]
-        figures = [Figure(p.name, f"mode {i + 1}: {result.freq_hz[i]:.3f} Hz")
-                   for i, p in enumerate(paths)]
+        with ws.timed("mode images"):  # one scene and one camera for all images
+            paths = plot_modes(model, result, out, range(n), prefix="mode",
+                               progress=lambda it: progress(it, "mode images", ws.bars))
+        figures += [Figure(p.name, f"mode {i + 1}: {result.freq_hz[i]:.3f} Hz")
+                    for i, p in enumerate(paths)]
     est = result.error_estimate
     header = ("mode", "frequency (Hz)", "rigid") + (("estimated rel. error",) if est is not
                                                     None else ())
-    rows = tuple((i + 1, float(f), "yes" if r else "no") + ((f"{est[i]:.1e}",) if est is not
-                                                           None else ())
+    rows = tuple((i + 1, Quantity(float(f), digits=6), "yes" if r else "no")
+                 + ((Quantity(float(est[i]), digits=2),) if est is not None else ())
                  for i, (f, r) in enumerate(zip(result.freq_hz, result.rigid, strict=True)))
-    text = (f"Part {spec.part!r}, {spec.model} model ({result.method} solver):"
+    solver = f", factorisation {result.solver}" if result.solver else ""
+    text = (f"Part {spec.part!r}, {spec.model} model ({result.method} solver{solver}):"
             f" {result.n_modes} modes.",)
-    section = Section("Natural modes", text, (Table("Natural frequencies", header, rows),),
+    with ws.timed("mass participation"):
+        tables, notes = participation_tables(model if model is not None else
+                                             ws.model(spec.part), result, spec.part)
+    section = Section("Natural modes", text + notes,
+                      (Table("Natural frequencies", header, rows), *tables),
                       tuple(figures), tuple(files), gallery=True)
     return section, {"part": spec.part, "model": spec.model, "freq_hz": _list(result.freq_hz)}
 
@@ -146,9 +132,9 @@ def run_modes(ws, spec, out):
 def run_sweep(ws, spec, out):
     """Quasi-eigenfrequencies over the drive angle, per speed."""
     phi = np.asarray(spec.angles, dtype=float)
-    curves = {}
+    unit, curves = spec.speed_unit, {}
     for W in spec.speeds:
-        label = f"{W * RPM:.0f} rpm"
+        label = format_speed(W, unit)
         with ws.timed("sweep"):
             if spec.mechanism is not None:
                 q = quasi_modes(ws.prepared.mechanisms[spec.mechanism], phi, Omega=W)
@@ -158,13 +144,12 @@ def run_sweep(ws, spec, out):
                 curves[label] = _Curve(s.phi, s.freq_hz)
     what = f"mechanism {spec.mechanism!r} alone" if spec.mechanism else "coupled machine"
     plot_quasi_frequencies(curves, out / "quasi_frequencies.png",
-                           title=f"{ws.scene.name}: {what}")
+                           title=f"{ws.scene.name}: {what}", speed_unit=unit)
     n = next(iter(curves.values())).freq_hz.shape[1]
-    rows = [(W, float(np.rad2deg(a)), *c.freq_hz[i]) for W, c in zip(spec.speeds,
-                                                                      curves.values(),
-                                                                      strict=True)
+    rows = [(W * speed_scale(unit), float(np.rad2deg(a)), *c.freq_hz[i])
+            for W, c in zip(spec.speeds, curves.values(), strict=True)
             for i, a in enumerate(c.phi)]
-    _write_csv(out / "quasi_frequencies.csv", ["speed_rad_s", "angle_deg"] +
+    _write_csv(out / "quasi_frequencies.csv", [_speed_column(unit), "angle_deg"] +
                [f"f{k + 1}_hz" for k in range(n)], rows)
     table_rows = tuple((label, k + 1, float(np.nanmin(c.freq_hz[:, k])),
                         float(np.nanmax(c.freq_hz[:, k])))
@@ -173,13 +158,24 @@ def run_sweep(ws, spec, out):
     for angle in spec.mode_images_at:
         figures.append(_coupled_image(ws, spec, angle, out))
     text = (f"{phi.size} drive angles from {np.rad2deg(phi[0]):.1f}° to"
-            f" {np.rad2deg(phi[-1]):.1f}°, {n} branches, speeds {list(curves)}.",)
+            f" {np.rad2deg(phi[-1]):.1f}°, {n} branches, speeds {', '.join(curves)}.",)
     section = Section("Quasi-eigenfrequencies over the drive angle", text,
                       (Table("Range of each branch over the sweep", ("speed", "branch",
                                                                     "min (Hz)", "max (Hz)"),
                              table_rows),), tuple(figures), ("quasi_frequencies.csv",))
     return section, {"phi_rad": _list(phi), "speeds_rad_s": list(spec.speeds),
                      "freq_hz": [_list(c.freq_hz) for c in curves.values()]}
+
+
+def _speed_column(unit: str) -> str:
+    """CSV column of a drive speed in ``unit``: speed_rpm, speed_rad_s."""
+    return "speed_" + unit.replace("/", "_")
+
+
+def _speed_range(lo: float, hi: float, unit: str) -> str:
+    """Speeds lo..hi (rad/s) as text in ``unit``: "100..300 rpm", or "100 rpm"."""
+    a, b = format_speed(lo, unit), format_speed(hi, unit)
+    return a if a == b else f"{a.split()[0]}..{b}"
 
 
 @dataclass(frozen=True)
@@ -202,9 +198,10 @@ def _coupled_image(ws, spec, angle: float, out) -> Figure:
     name = "coupled_mode_" + f"{deg:g}".replace(".", "p") + "deg.png"  # 22.5° → 22p5deg
     part = next(iter(ws.scene.parts))
     plot_coupled_mode(ws.model(part), ws.machine(), at.vectors[0, :, 0], at.freq_hz[0, 0],
-                      out / name, angle=angle)
-    return Figure(name, f"lowest coupled quasi-mode at φ = {deg:g}°, {W * RPM:.0f} rpm:"
-                  f" {at.freq_hz[0, 0]:.2f} Hz")
+                      out / name, angle=angle, speed=W, mode_number=1,
+                      speed_unit=spec.speed_unit)
+    return Figure(name, f"lowest coupled quasi-mode at φ = {deg:g}°,"
+                  f" {format_speed(W, spec.speed_unit)}: {at.freq_hz[0, 0]:.2f} Hz")
 
 
 def _damped(ws, rayleigh):
@@ -225,37 +222,39 @@ def run_stability(ws, spec, out):
     chart = merge_charts(points, 1, len(points), speeds, None)
     radius, error, stable = chart.spectral_radius[0], chart.error[0], chart.stable[0]
     ok, steps = chart.converged[0], chart.n_steps[0]
+    unit, scale = spec.speed_unit, speed_scale(spec.speed_unit)
     plot_stability_chart(chart, out / "stability_chart.png", title=ws.scene.name,
-                         speed_unit="rpm")
-    _write_csv(out / "stability.csv", ["speed_rad_s", "speed_rpm", "spectral_radius",
+                         speed_unit=unit)
+    _write_csv(out / "stability.csv", [_speed_column(unit), "spectral_radius",
                                        "error_estimate", "converged", "n_steps", "stable"],
-               [(W, W * RPM, r, e, int(c), n, int(s) if c else "")
+               [(W * scale, r, e, int(c), n, int(s) if c else "")
                 for W, r, e, c, n, s in zip(speeds, radius, error, ok, steps, stable,
                                             strict=True)])
     unstable = speeds[~stable & ok]
-    text = (f"{speeds.size} speeds from {speeds[0] * RPM:.0f} to {speeds[-1] * RPM:.0f} rpm;"
+    text = (f"{speeds.size} speeds from {format_speed(speeds[0], unit)} to"
+            f" {format_speed(speeds[-1], unit)};"
             f" Rayleigh damping (mass, stiffness) = {spec.rayleigh}. Magnus steps per period"
             f" doubled from {spec.n_steps} until the spectral radius changed by at most"
             f" {spec.rtol:g} (relative; {steps.min()}..{steps.max()} steps were needed)."
             f" Unstable at {unstable.size} speeds"
-            + (f" ({unstable.min() * RPM:.0f}..{unstable.max() * RPM:.0f} rpm)." if
-               unstable.size else "."),)
+            + (f" ({_speed_range(unstable.min(), unstable.max(), unit)}, shaded in the"
+               " chart)." if unstable.size else "."),)
     flags = ()
     if not ok.all():
-        bad = speeds[~ok] * RPM
-        where = (f"{bad.min():.0f} rpm" if bad.size == 1 else
-                 f"{bad.min():.0f}..{bad.max():.0f} rpm")
-        flags = (f"{int((~ok).sum())} of {speeds.size} speeds ({where}) did NOT converge"
+        bad = speeds[~ok]
+        flags = (f"{int((~ok).sum())} of {speeds.size} speeds"
+                 f" ({_speed_range(bad.min(), bad.max(), unit)}) did NOT converge"
                  f" within max_steps = {spec.max_steps} Magnus steps per"
-                 " period: their spectral radius and verdict may be wrong (hatched in the"
-                 " chart, converged = 0 in stability.csv). Raise max_steps.",)
+                 " period: their spectral radius and verdict may be wrong (hollow circles on"
+                 " a hatched band in the chart, converged = 0 in stability.csv). Raise"
+                 " max_steps.",)
         ws.log(f"stability: {flags[0]}")
-    rows = tuple((float(W * RPM), float(r), f"{e:.1e}", "yes" if s else "no")
-                 if c else (float(W * RPM), Flagged(f"{r:.6g} NOT CONVERGED"), f"{e:.1e}",
+    rows = tuple((float(W * scale), float(r), f"{e:.1e}", "yes" if s else "no")
+                 if c else (float(W * scale), Flagged(f"{r:.6g} NOT CONVERGED"), f"{e:.1e}",
                             Flagged("unknown"))
                  for W, r, e, c, s in zip(speeds, radius, error, ok, stable, strict=True))
     section = Section("Stability chart", text, (Table("Spectral radius of the monodromy"
-                                                      " matrix", ("speed (rpm)", "max |μ|",
+                                                      " matrix", (f"speed ({unit})", "max |μ|",
                                                                   "error estimate of max |μ|",
                                                                   "stable"), rows),),
                       (Figure("stability_chart.png", "Floquet stability over drive speed"),),
@@ -286,7 +285,11 @@ def run_response(ws, spec, out):
     _write_csv(out / "response.csv", ["t_s", "phi_rad", *columns],
                [(t, p, *(c[i] for c in columns.values()))
                 for i, (t, p) in enumerate(zip(r.t, r.phi, strict=True))])
-    _plot_response(r, columns, spec.kind, out / "response.png")
+    title = (f"Periodic steady state at {format_speed(spec.speed, spec.speed_unit)}"
+             if spec.kind == "periodic" else
+             f"Run-up {format_speed(spec.speed_start, spec.speed_unit)} →"
+             f" {format_speed(spec.speed_end, spec.speed_unit)} in {spec.duration:g} s")
+    _plot_response(r, columns, spec.kind, out / "response.png", title)
     loose = r.converged is False
 
     def cell(x):
@@ -295,12 +298,14 @@ def run_response(ws, spec, out):
     rows = tuple((k, cell(np.abs(c).max()), cell(c.max() - c.min()))
                  for k, c in columns.items())
     if spec.kind == "periodic":
-        text = (f"Periodic steady state at {spec.speed * RPM:.0f} rpm by shooting"
+        text = (f"Periodic steady state at {format_speed(spec.speed, spec.speed_unit)} by"
+                " shooting"
                 f" (generalised-α), {r.n_steps} steps per period: steps doubled from"
                 f" {spec.n_steps} until q changed by at most {spec.rtol:g} (relative, mass"
                 f" norm); estimated error {r.error:.1e}.",)
     else:
-        text = (f"Run-up {spec.speed_start * RPM:.0f} → {spec.speed_end * RPM:.0f} rpm in"
+        text = (f"Run-up {format_speed(spec.speed_start, spec.speed_unit)} →"
+                f" {format_speed(spec.speed_end, spec.speed_unit)} in"
                 f" {spec.duration:g} s, {spec.n_steps} steps (generalised-α, fixed steps).",)
     flags = ()
     if loose:
@@ -321,20 +326,32 @@ def run_response(ws, spec, out):
     return section, summary
 
 
-def _plot_response(r, columns, kind, path) -> None:
+def _response_unit(name: str) -> str:
+    """Unit of a response column: frame DOFs ``part:node:dof`` are m (u*) or rad (r*);
+    mechanism coordinates are in the mechanism's SI units (m or rad)."""
+    dof = name.rsplit(":", 1)[-1] if name.count(":") == 2 else ""
+    return {"u": "m", "r": "rad"}.get(dof[:1], "m or rad")
+
+
+def _plot_response(r, columns, kind, path, title: str = "") -> None:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure as MplFigure
 
-    fig = MplFigure(figsize=(8, 1.2 + 1.8 * max(1, len(columns))), dpi=110)
+    fig = MplFigure(figsize=(8, 1.2 + 1.8 * max(1, len(columns))), dpi=110,
+                    layout="constrained")
     FigureCanvasAgg(fig)
+    if title:
+        fig.suptitle(title, fontsize=10)
     x = np.rad2deg(r.phi) if kind == "periodic" else r.t
     for i, (name, values) in enumerate(columns.items() or {"(none)": 0 * x}.items()):
         ax = fig.add_subplot(max(1, len(columns)), 1, i + 1)
         ax.plot(x, values, lw=1.0)
-        ax.set_ylabel(name, fontsize=8)
+        ax.set_ylabel(f"{name}\n({_response_unit(name)})", fontsize=8)
+        ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3), useMathText=True)
         ax.grid(alpha=0.3)
+        if kind == "periodic":
+            set_angle_axis(ax, float(x.min()), float(x.max()))  # ticks every 45°
     ax.set_xlabel("drive angle φ (°)" if kind == "periodic" else "time t (s)")
-    fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png")
 
@@ -381,8 +398,9 @@ def run_check(ws, spec, out):
     tables = [Table("Reduced versus full at the check angles", ("angle (°)", "mode",
                                                                "full (Hz)", "reduced (Hz)",
                                                                "rel. error", "MAC"),
-                    tuple((f"{np.rad2deg(a):.1f}", j + 1, float(comp.freq_full_hz[i, j]),
-                           float(comp.freq_reduced_hz[i, j]),
+                    tuple((f"{np.rad2deg(a):.1f}", j + 1,  # 8 digits: the error is ~1e-7
+                           Quantity(float(comp.freq_full_hz[i, j]), digits=8),
+                           Quantity(float(comp.freq_reduced_hz[i, j]), digits=8),
                            f"{comp.rel_error[i, j]:.2e}", f"{comp.diag_mac[i, j]:.8f}")
                           for i, a in enumerate(comp.phi) for j in k)),
               Table("Speed versus error", ("model", "coordinates", "ms per angle",
@@ -409,8 +427,11 @@ def _plot_speed_error(rows, path) -> None:
     fig = MplFigure(figsize=(6.5, 4.2), dpi=110)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
+    times = [r[2] for r in rows]
+    ax.set_xscale("log" if needs_log_scale(times) else "linear")  # a decade or more: log
+    ax.set_yscale("log")
     for name, n, ms, err, _ in rows[1:]:
-        ax.loglog(ms, max(err, 1e-16), "o")
+        ax.plot(ms, max(err, 1e-16), "o")
         ax.annotate(f"{name} ({n})", (ms, max(err, 1e-16)), fontsize=7, xytext=(4, 2),
                     textcoords="offset points")
     ax.axvline(rows[0][2], color="0.4", ls="--", lw=0.8)
@@ -424,5 +445,191 @@ def _plot_speed_error(rows, path) -> None:
         fig.savefig(tmp, format="png")
 
 
+def run_drive_event(ws, spec, out):
+    """A drive run up to speed, tripped when its force reaches a limit, braked to rest in
+    each braking time: CSV per run, a PNG of the histories, a table of the peaks."""
+    model, mech = ws.prepared.mechanisms[spec.mechanism], ws.scene.mechanisms[spec.mechanism]
+    with ws.timed("time integration"):
+        result = trip_and_brake(model, spec.drive, spec.start, spec.speed, spec.ramp_time,
+                                spec.trip_force, spec.braking_times, spec.time_after_stop,
+                                end=spec.end, t_max=spec.t_max, samples=spec.samples,
+                                method=spec.method, rtol=spec.rtol, atol=spec.atol,
+                                max_step=spec.max_step or math.inf, verify=spec.verify,
+                                max_evaluations=MAX_DRIVE_EVALUATIONS)
+    free = [q.name for q in model.mechanism.coordinates if q not in model.mechanism.drives]
+    keys = ("force", spec.drive, *(spec.outputs if spec.outputs is not None else free))
+    what = {key: _event_quantity(mech, model, spec, key) for key in keys}
+    runs = {f"braking {format_value(r.brake_time, 's', trim=True)}": (r.brake_time, r.history)
+            for r in result.runs} or {"approach (no trip)": (None, result.approach)}
+    values = {label: _event_values(model, spec, h, keys) for label, (_, h) in runs.items()}
+    files = []
+    for label, (tb, h) in runs.items():
+        name = ("drive_event_approach.csv" if tb is None else "drive_event_braking_"
+                + f"{tb:g}".replace(".", "p") + "s.csv")
+        write_history_csv(h.t, {_csv_column(key, what[key][1]): v
+                                for key, v in values[label].items()}, out / name)
+        files.append(name)
+    _plot_drive_event(result, runs, values, what, out / "drive_event.png",
+                      f"{ws.scene.name}: {what['force'][0]} and braking" if result.tripped
+                      else f"{ws.scene.name}: no trip")
+    force_unit = "N·m" if spec.rotational else "N"
+    text = _drive_event_text(spec, model.mechanism.name, result, what, force_unit)
+    flags = () if result.tripped else (text[1] + " Nothing was braked.",)
+    for flag in flags:
+        ws.log(f"drive_event: {flag}")
+    tables = (_drive_event_table(result, values, what, spec),) if result.tripped else ()
+    section = Section("Drive-force trip and braking", text[:1] + text[2:] if flags else text,
+                      tables,
+                      (Figure("drive_event.png", "Time histories; dotted line: the trip"
+                              if result.tripped else "Time histories (no trip)"),),
+                      tuple(files), warnings=flags)
+    return section, _drive_event_numbers(result, values, keys[2:])
+
+
+def _event_quantity(mech, model, spec, key: str) -> tuple:
+    """(description, dimension or None) of a quantity shown by a drive event."""
+    if key == "force":
+        label, kind = describe_quantity(mech, f"force {spec.drive}")
+        return (label if kind else f"force of drive {spec.drive}",
+                MOMENT if spec.rotational else FORCE)
+    label, kind = describe_quantity(mech, key)
+    if key == spec.drive:
+        kind = ANGLE if spec.rotational else LENGTH
+    elif kind is None and key.startswith("spring"):
+        spring = [el for el in model.mechanism.elements
+                  if isinstance(el, Spring)][int(key[6:]) - 1]
+        c = str(spring.c)
+        kind = {STIFFNESS: FORCE, ROT_STIFFNESS: MOMENT}.get(parameter_kinds(mech).get(c))
+        label = f"force of spring {key[6:]} ({c})"
+    return label, kind
+
+
+def _event_values(model, spec, history, keys) -> dict:
+    """SI values (n_t,) of each quantity of a drive event over one history."""
+    names = [q.name for q in model.mechanism.coordinates]
+    drives = [q.name for q in model.mechanism.drives]
+    springs = spring_forces(model, history.q) if any(k.startswith("spring") for k in keys) \
+        else None
+    return {key: history.drive_forces[:, drives.index(spec.drive)] if key == "force" else
+            springs[:, int(key[6:]) - 1] if key.startswith("spring") and key not in names
+            else history.q[:, names.index(key)] for key in keys}
+
+
+_SI_UNITS = {LENGTH: "m", ANGLE: "rad", FORCE: "N", MOMENT: "N·m"}
+
+
+def _csv_column(key: str, kind) -> str:
+    """CSV header of a quantity: name and SI unit (``force_N``, ``q3_rad``)."""
+    unit = _SI_UNITS.get(kind, "SI").replace("·", "_")
+    return f"{key.replace(' ', '_')}_{unit}"
+
+
+def _display(kind, values) -> tuple[str, float]:
+    """(unit, factor from SI) in which a quantity reads well: kN, MN, mm, degrees."""
+    peak = float(np.nanmax(np.abs(values))) if np.size(values) else 0.0
+    if kind in (FORCE, MOMENT):
+        unit = _SI_UNITS[kind]
+        return next(((p + unit, f) for p, f, lim in (("M", 1e-6, 1e6), ("k", 1e-3, 1e3))
+                     if peak >= lim), (unit, 1.0))
+    if kind is ANGLE:
+        return "°", 180 / math.pi
+    if kind is LENGTH and peak < 0.1:
+        return "mm", 1e3
+    return _SI_UNITS.get(kind, "SI units"), 1.0
+
+
+def _plot_drive_event(result, runs, values, what, path, title) -> None:
+    panels, levels = {}, {}
+    for key, (label, kind) in what.items():
+        unit, f = _display(kind, np.concatenate([v[key] for v in values.values()]))
+        sign = ", tension +" if key.startswith("spring") and key not in result.coordinate_names \
+            else ""
+        ylabel = f"{label}\n({unit}{sign})"
+        panels[ylabel] = {run: (h.t, f * values[run][key]) for run, (_, h) in runs.items()}
+        if key == "force":
+            levels[ylabel] = (f * result.limit, "trip force " + format_value(
+                result.limit, _SI_UNITS[kind], trim=True))
+    event = (result.t_trip, "trip") if result.tripped else None
+    plot_event_histories(panels, path, event, levels, title)
+
+
+def _drive_event_text(spec, machine: str, result, what, force_unit: str) -> tuple:
+    unit = "rad" if spec.rotational else "m"
+
+    def q(x, u=unit):
+        return format_value(x, u, trim=True)
+    brakes = ", ".join(q(b, "s") for b in spec.braking_times)
+    drive = what[spec.drive][0] + ("" if what[spec.drive][0] == spec.drive else
+                                   f" {spec.drive}")
+    case = (f"Mechanism {spec.mechanism!r} ({machine}) with the {drive} prescribed:"
+            " nonlinear equations of the 2nd kind. From static rest"
+            f" at {spec.drive} = {q(spec.start)} the drive speed is ramped to"
+            f" {q(spec.speed, unit + '/s')} in {q(spec.ramp_time, 's')} (cycloidal), then held,"
+            f" until the {what['force'][0]} reaches the trip force"
+            f" {q(spec.trip_force, force_unit)}; then the drive is braked to rest (cycloidal)"
+            f" in {brakes} and followed for"
+            f" {q(spec.time_after_stop, 's')}.")
+    end = result.approach
+    outcome = (f"Tripped at t = {q(result.t_trip, 's')}, {spec.drive} ="
+               f" {q(result.drive_at_trip)}; the {what['force'][0]} was"
+               f" {q(result.static_force_start, force_unit)} at the start." if result.tripped
+               else f"No trip: the {what['force'][0]} reached at most"
+               f" {q(result.extreme_before_trip, force_unit)}, short of the trip force"
+               f" {q(spec.trip_force, force_unit)}, before the run ended at t ="
+               f" {q(end.t[-1], 's')}, {spec.drive} ="
+               f" {q(end.q[-1, result.coordinate_names.index(spec.drive)])}"
+               " (end of travel or t_max).")
+    return case, outcome, result.accuracy.statement(force_unit)
+
+
+def _extreme(values: np.ndarray) -> float:
+    """The value of largest magnitude (signed)."""
+    return float(values[np.argmax(np.abs(values))]) if values.size else math.nan
+
+
+def _drive_event_table(result, values, what, spec) -> Table:
+    outputs = [k for k in what if k not in ("force", spec.drive)]
+    force_unit = _SI_UNITS[what["force"][1]]
+    header = ("braking time", "trip time", "stop time", f"peak {what['force'][0]}",
+              "quasi-static at rest", "dynamic factor",
+              *(f"extreme {what[k][0]} after the trip" for k in outputs))
+    rows = []
+    for run, v in zip(result.runs, values.values(), strict=False):
+        after = run.history.t >= result.t_trip
+        cells = []
+        for k in outputs:
+            unit, f = _display(what[k][1], v[k])
+            cells.append(Quantity(f * _extreme(v[k][after]), "" if unit == "SI units" else
+                                  unit))
+        rows.append((Quantity(run.brake_time, "s"), Quantity(result.t_trip, "s"),
+                     Quantity(run.t_stop, "s"), Quantity(run.peak_force, force_unit),
+                     Quantity(run.static_force_end, force_unit),
+                     run.peak_force / run.static_force_end, *cells))
+    return Table("Peaks per braking time (extremes: the value of largest magnitude at or"
+                 " after the trip, signed)", header, tuple(rows))
+
+
+def _drive_event_numbers(result, values, outputs) -> dict:
+    """Key numbers for results.json (SI; NaN as None); extremes of the ``outputs``."""
+    def num(x):
+        return float(x) if math.isfinite(x) else None
+    acc = result.accuracy
+    runs = [{"braking_time_s": r.brake_time, "t_stop_s": r.t_stop,
+             "peak_drive_force": r.peak_force, "static_drive_force_at_rest": r.static_force_end,
+             "extremes_after_trip": {k: _extreme(v[k][r.history.t >= result.t_trip])
+                                     for k in outputs}}
+            for r, v in zip(result.runs, values.values(), strict=False)]
+    return {"drive": result.drive, "tripped": result.tripped, "t_trip_s": num(result.t_trip),
+            "drive_at_trip": num(result.drive_at_trip), "trip_force": result.limit,
+            "static_drive_force_at_start": result.static_force_start,
+            "extreme_drive_force_before_trip": result.extreme_before_trip, "runs": runs,
+            "message": result.message,
+            "accuracy": {"method": acc.method, "rtol": acc.rtol, "atol": acc.atol,
+                         "max_step_s": num(acc.max_step), "checked": acc.checked,
+                         "trip_time_change_s": num(acc.trip_time_change),
+                         "peak_force_change": num(acc.peak_force_change),
+                         "force_change": num(acc.force_change)}}
+
+
 TASKS = {"modes": run_modes, "sweep": run_sweep, "stability": run_stability,
-         "response": run_response, "check": run_check}
+         "response": run_response, "check": run_check, "drive_event": run_drive_event}

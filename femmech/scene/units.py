@@ -67,11 +67,14 @@ ROT_DAMPING = Kind("a rotational damping coefficient", _dim(kg=1, m=2, s=-1, rad
 FREQUENCY = Kind("a frequency", _dim(s=-1), "'400 Hz'")
 ANGLE = Kind("an angle", _dim(rad=1), "'90 deg'")
 SPEED = Kind("an angular speed", _dim(s=-1, rad=1), "'1200 rpm' or '125 rad/s'")
+LINEAR_SPEED = Kind("a linear speed", _dim(m=1, s=-1), "'0.1 m/s'")
+ACCELERATION = Kind("an acceleration", _dim(m=1, s=-2), "'9.81 m/s^2'")
 INVERSE_TIME = Kind("a rate", _dim(s=-1), "'2 1/s'")
 DIMENSIONLESS = Kind("a plain number", _dim(), "0.3")
 
 KINDS = (LENGTH, AREA, SECOND_MOMENT, MASS, TIME, FORCE, MOMENT, PRESSURE, DENSITY, INERTIA,
-         STIFFNESS, ROT_STIFFNESS, DAMPING, ROT_DAMPING, FREQUENCY, ANGLE, SPEED, DIMENSIONLESS)
+         STIFFNESS, ROT_STIFFNESS, DAMPING, ROT_DAMPING, FREQUENCY, ANGLE, SPEED, LINEAR_SPEED,
+         ACCELERATION, DIMENSIONLESS)
 
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
 _FACTOR = re.compile(r"^([A-Za-z]+)(?:\^?(-?\d))?$")  # powers -9..9

@@ -19,7 +19,6 @@ from contextlib import contextmanager
 
 from femmech.coupling import couple
 from femmech.fe.model import FEModel
-from femmech.output.report import Table
 from femmech.reduction.substructures import assemble_parts
 from femmech.scene.build import (
     Prepared,
@@ -126,9 +125,3 @@ class Workshop:
 
 def _key(scene: Scene, spec, f_max_hz: float) -> str:
     return sha256_key(reduction_key_data(scene, spec, f_max_hz))
-
-
-def timings_table(ws: Workshop) -> Table:
-    """Seconds per step."""
-    return Table("Timings", ("step", "seconds"),
-                 tuple((k, round(v, 3)) for k, v in ws.timings.items()))
