@@ -8,7 +8,8 @@ from femmech.fe import sections
 from femmech.reduction.component_modes import craig_bampton
 
 
-def test_reprs_are_one_line_summaries():
+def _cantilever():
+    """A 2 m steel cantilever of 20 beam elements, circular 50 mm section."""
     x = np.linspace(0.0, 2.0, 21)
     beam = fm.Mesh.from_lines(np.column_stack([x, 0 * x, 0 * x]),
                               np.column_stack([np.arange(20), np.arange(1, 21)]),
@@ -16,6 +17,11 @@ def test_reprs_are_one_line_summaries():
     steel = fm.Material(E=210e9, nu=0.3, rho=7850.0)
     model = fm.build_model(beam, {"all": fm.BeamProperty(sections.circle(0.05), steel)},
                            supports=[fm.Support("root", dofs="all")])
+    return beam, model
+
+
+def test_reprs_are_one_line_summaries():
+    beam, model = _cantilever()
     modes = fm.modes(model, n_modes=8)
     se = craig_bampton(model, ["tip"], n_modes=6, residual_vectors=True)
     expected = [
@@ -51,13 +57,7 @@ def test_html_reprs_are_small_tables():
     from femmech.coupling import couple
     from femmech.html import MAX_ROWS
 
-    x = np.linspace(0.0, 2.0, 21)
-    beam = fm.Mesh.from_lines(np.column_stack([x, 0 * x, 0 * x]),
-                              np.column_stack([np.arange(20), np.arange(1, 21)]),
-                              node_sets={"root": [0], "tip": [20]})
-    steel = fm.Material(E=210e9, nu=0.3, rho=7850.0)
-    model = fm.build_model(beam, {"all": fm.BeamProperty(sections.circle(0.05), steel)},
-                           supports=[fm.Support("root", dofs="all")])
+    beam, model = _cantilever()
     modes = fm.modes(model, n_modes=20)  # 21: the round beam's 20th/21st modes are a pair
     html = _html_ok(modes, f"ModeSet: {modes.n_modes} modes")
     assert f"{modes.freq_hz[0]:.6g}" in html
