@@ -20,7 +20,7 @@ import numpy as np
 
 from femmech.analysis.modes import ModeSet
 from femmech.fe.model import FEModel
-from femmech.output.export import atomic_path
+from femmech.output.export import _check_sizes, _mode_indices, atomic_path
 from femmech.output.plot import _plot, mode_scale, mode_title
 
 MAX_FRAMES = 240
@@ -61,18 +61,17 @@ def animate_mode(model: FEModel, modes: ModeSet, index: int, filename, n_frames:
         raise ValueError(f"animation file {target.name}: the suffix must be .gif")
     if not target.parent.is_dir():
         raise FileNotFoundError(f"cannot write {target}: folder {target.parent} does not exist")
-    if not 0 <= int(index) < modes.n_modes or int(index) != index:
-        raise ValueError(f"mode index {index} does not exist: the mode set has"
-                         f" {modes.n_modes} modes (0-based indices)")
+    _check_sizes(model, modes)
+    index = int(_mode_indices(modes, [index])[0])
     if int(n_frames) != n_frames or not 4 <= n_frames <= MAX_FRAMES:
         raise ValueError(f"n_frames must be an integer from 4 to {MAX_FRAMES}, got {n_frames}")
     if not 0.5 <= fps <= 50.0:
         raise ValueError(f"fps must lie between 0.5 and 50, got {fps}")
-    shape = modes.shapes[:, int(index)]
+    shape = modes.shapes[:, index]
     scale = mode_scale(model, shape, kwargs.get("n_sub", 8)) if scale is None else float(scale)
     phases = np.cos(2.0 * np.pi * (np.arange(n_frames) + 0.5) / n_frames)
-    frames = _frames(modes, int(index), phases)
-    kwargs.setdefault("title", mode_title(modes, int(index)))
+    frames = _frames(modes, index, phases)
+    kwargs.setdefault("title", mode_title(modes, index))
     kwargs.setdefault("window_size", (800, 600))  # a GIF of 24 frames: about 0.8 MB
     with tempfile.TemporaryDirectory(prefix="femmech-gif-") as tmp:
         files = [Path(tmp) / f"frame_{k:03d}.png" for k in range(n_frames)]

@@ -22,11 +22,12 @@ Formats, chosen by the file's suffix:
     big models.
 
 Files are written atomically: the PVD's folder is filled under a temporary name and
-renamed into place, and the collection file is written last, so a failure leaves the
-previous series (or nothing), never half of one.
+renamed into place, then the collection file is written (its own atomic rename), so no
+file is ever half-written and a failure while the steps are written leaves the previous
+series whole.
 
-Stage 6 (output): uses fe, reduction (recovery of full fields), coupling and
-output.export (cells, atomic writes); meshio only.
+Stage 6 (output): uses fe, coupling, output.machine (recovery of the frame's full
+fields) and output.export (checks, cells, atomic writes); meshio only.
 """
 
 from __future__ import annotations
@@ -43,9 +44,9 @@ from femmech.analysis.modes import ModeSet
 from femmech.coupling import CoupledSystem
 from femmech.fe.dofs import DOF_PER_NODE
 from femmech.fe.model import FEModel
-from femmech.output.export import _add_field_data, atomic_path
+from femmech.output.export import _add_field_data, _check_sizes, _mode_indices, atomic_path
+from femmech.output.machine import frame_shape
 from femmech.output.surfaces import cell_blocks
-from femmech.reduction.superelement import Superelement
 
 FORMATS = (".pvd", ".xdmf")
 
@@ -67,14 +68,8 @@ def write_mode_series(model: FEModel, modes: ModeSet, filename, indices=None) ->
     -------
     Path
     """
-    if modes.shapes.shape[0] != model.n_dof:
-        raise ValueError(f"the mode set has {modes.shapes.shape[0]} DOFs, the model"
-                         f" {model.n_dof}: modes of another model?")
-    idx = np.arange(modes.n_modes) if indices is None else np.asarray(indices, dtype=int)
-    bad = idx[(idx < 0) | (idx >= modes.n_modes)]
-    if bad.size:
-        raise ValueError(f"mode index {bad[0]} does not exist: the mode set has"
-                         f" {modes.n_modes} modes (0-based indices)")
+    _check_sizes(model, modes)
+    idx = _mode_indices(modes, indices)
     steps = [(float(i + 1), _nodal(modes.shapes[:, i]),
               {"frequency_hz": float(modes.freq_hz[i])}) for i in idx]
     return _write(model, steps, filename, "mode number")
@@ -153,19 +148,13 @@ def write_response_series(model: FEModel, system: CoupledSystem, response, filen
 
 
 def _frame_field(model: FEModel, system: CoupledSystem, x) -> np.ndarray:
-    """Full FE displacement (n_dof,) of the frame part of coupled coordinates x."""
-    x = np.asarray(x)
-    part = (x.real if np.iscomplexobj(x) else x)[:system.n_frame]
-    frame = system.frame
-    if isinstance(frame, Superelement):
-        if frame.n_dof != model.n_dof:
-            raise ValueError(f"the superelement recovers {frame.n_dof} DOFs, the model has"
-                             f" {model.n_dof}: pass the FE model it was reduced from")
-        return frame.recover(part)
-    if isinstance(frame, FEModel):
-        return frame.expand(part)
-    raise TypeError("series support coupled systems whose frame is a Superelement or an"
-                    f" FEModel, got {type(frame).__name__}")
+    """Full FE displacement (n_dof,) of the frame part of coupled coordinates x, checked
+    against ``model`` (a superelement recovers the DOFs of the model it was reduced from)."""
+    u = frame_shape(system, x)
+    if u.shape[0] != model.n_dof:
+        raise ValueError(f"the coupled system's frame recovers {u.shape[0]} DOFs, the model"
+                         f" has {model.n_dof}: pass the FE model it was reduced from")
+    return u
 
 
 def _nodal(u_full: np.ndarray) -> dict:
