@@ -27,19 +27,19 @@ def flagged(text: str) -> str:
     return f'<span style="{_FLAG}">{escape(text)}</span>'
 
 
+class Flag:
+    """A table value shown as flagged (bold red), e.g. ``Flag("NOT CONVERGED")``."""
+
+    def __init__(self, text: str):
+        self.text = text
+
+
 def _cell(value) -> str:
     if isinstance(value, Flag):
         return flagged(value.text)
     if isinstance(value, float):
         return escape(f"{value:.6g}")
     return escape(str(value))
-
-
-class Flag:
-    """A table value shown as flagged (bold red), e.g. ``Flag("NOT CONVERGED")``."""
-
-    def __init__(self, text: str):
-        self.text = text
 
 
 def html_summary(title: str, facts: Sequence[tuple[str, object]] = (),

@@ -37,6 +37,7 @@ from femmech.errors import ConvergenceWarning
 from femmech.fe.model import node_index
 from femmech.mechanisms import Spring, quasi_modes
 from femmech.output import export_modes_vtu, frequency_table, plot_mac, write_frequency_csv
+from femmech.output.animate import animate_mode
 from femmech.output.charts import format_speed, needs_log_scale, set_angle_axis, speed_scale
 from femmech.output.export import atomic_path
 from femmech.output.formatting import Quantity, format_value
@@ -96,8 +97,6 @@ def run_modes(ws, spec, out):
         if k > result.n_modes:
             ws.log(f"modes: animate mode {k}: only {result.n_modes} modes were computed")
             continue
-        from femmech.output.animate import animate_mode
-
         with ws.timed("mode animations"):
             path = animate_mode(model, result, k - 1, out / f"mode_{k:02d}.gif")
         figures.append(Figure(path.name, f"mode {k}: {result.freq_hz[k - 1]:.3f} Hz, moving"
