@@ -22,7 +22,8 @@ rigid-body vectors, not from element formulas, so point masses and every element
 count. :func:`element_group_masses` gives the share of each element group (density
 times length·area, area·thickness or volume) for a cross-check against M.
 
-Stage 5 (analysis): uses fe (checks.cell_measure, dofs, model) and solve (factorize);
+Stage 5 (analysis): uses fe (checks.cell_measure, dofs, model) and solve (factorize, the
+rigid-body vectors of :func:`femmech.solve.lobpcg.rigid_body_modes`);
 pure functions on arrays, plus :func:`participation` for an FEModel and a ModeSet.
 """
 
@@ -35,6 +36,7 @@ import numpy as np
 from femmech.fe.checks import cell_measure
 from femmech.fe.dofs import DOF_PER_NODE
 from femmech.fe.model import BEAM_PROPERTY_COLUMNS, FEModel
+from femmech.solve.lobpcg import rigid_body_modes
 
 DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
 """The six rigid-body directions: translations along and rotations about x, y, z."""
@@ -60,18 +62,14 @@ def rigid_body_vectors(points, reference=(0.0, 0.0, 0.0), rotations=None) -> np.
         False for nodes without rotational DOFs (nodes of solid elements only): their
         rotation components stay 0. Default: every node has them (beams, shells).
     """
-    x = np.asarray(points, dtype=float) - np.asarray(reference, dtype=float)
+    x = np.asarray(points, dtype=float)
     if x.ndim != 2 or x.shape[1] != 3:
         raise ValueError(f"points must have shape (n_nodes, 3), got {np.shape(points)}")
     n = len(x)
-    R = np.zeros((n, DOF_PER_NODE, 6))
-    R[:, :3, :3] = np.eye(3)
-    for axis in range(3):
-        R[:, :3, 3 + axis] = np.cross(np.eye(3)[axis], x)
-        R[:, 3 + axis, 3 + axis] = 1.0
+    R = rigid_body_modes(x, np.arange(DOF_PER_NODE * n), center=reference)
     if rotations is not None:
-        R[~np.asarray(rotations, dtype=bool), 3:, :] = 0.0
-    return R.reshape(DOF_PER_NODE * n, 6)
+        R.reshape(n, DOF_PER_NODE, 6)[~np.asarray(rotations, dtype=bool), 3:, :] = 0.0
+    return R
 
 
 def participation_factors(shapes, M, R) -> np.ndarray:
