@@ -1,6 +1,6 @@
 """``python -m femmech`` is the ``femmech`` command (see :mod:`femmech.cli`).
 
-Stage 9: imports only femmech.cli.
+Stage 10: imports only femmech.cli.
 """
 
 import sys

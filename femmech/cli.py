@@ -24,7 +24,7 @@ Scene files are data: ``run`` executes Python code a scene names (``module =``) 
 ``--allow-code``, and only from the scene's folder (or ``--code-root``); ``check`` never
 runs it.
 
-Stage 8 (cli): uses scene, errors and version; only :mod:`femmech.__main__` imports it.
+Stage 9 (cli): uses scene, errors and version; only :mod:`femmech.__main__` imports it.
 """
 
 from __future__ import annotations

@@ -25,9 +25,10 @@ STAGES = {
     "reduction": 3,
     "coupling": 4,
     "analysis": 5,
-    "output": 6,
-    "scene": 7,
-    "cli": 8, "__main__": 9,
+    "chain": 6,
+    "output": 7,
+    "scene": 8,
+    "cli": 9, "__main__": 10,
 }
 """Stage of each top-level module or package of femmech: a module may import modules of a
 lower stage and of its own package, nothing else (fe and mechanisms, both stage 2, are

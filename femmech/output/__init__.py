@@ -21,7 +21,7 @@ does not import pyvista.
 * :mod:`.report`: one self-contained HTML report page.
 * :mod:`.folder`: one run, one output folder (staging folder and manifest).
 
-Stage 6 (output): uses analysis, coupling, reduction, fe and errors; of femmech only
+Stage 7 (output): uses analysis, coupling, reduction, fe and errors; of femmech only
 :mod:`femmech.scene` imports it.
 """
 

@@ -10,7 +10,7 @@ its staging folder is removed at once, or by the next run into the same folder i
 process was killed. A folder that is neither empty nor written by femmech is refused, so
 ``--out`` can never make femmech delete a user's files.
 
-Stage 6 (output): uses only errors.
+Stage 7 (output): uses only errors.
 """
 
 from __future__ import annotations

@@ -19,7 +19,7 @@ The drawing does not depend on shell thickness, and the plotter has its own docu
 theme, so the global pyvista theme does not change the image. pyvista is imported
 only inside the functions.
 
-Stage 6 (output): uses analysis.modes and .mode_types, fe and output.export,
+Stage 7 (output): uses analysis.modes and .mode_types, fe and output.export,
 .mode_geometry, .camera, .annotate and .renderer.
 """
 

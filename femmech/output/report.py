@@ -9,7 +9,7 @@ Every number in a table cell is formatted by :func:`femmech.output.formatting.fo
 (engineering notation, fixed significant digits, no float artefacts); NaN and infinite
 values are highlighted like :class:`Flagged` cells.
 
-Stage 6 (output): uses output.export and output.formatting.
+Stage 7 (output): uses output.export and output.formatting.
 """
 
 from __future__ import annotations

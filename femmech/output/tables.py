@@ -1,6 +1,6 @@
 """Frequency tables of a mode set: plain text for reports and logs, CSV for spreadsheets.
 
-Stage 6 (output): uses analysis.modes and output.export.
+Stage 7 (output): uses analysis.modes and output.export.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Stage 8, scene files: a machine and the analyses wanted, in one TOML file, run end to end.
+"""Stage 9, scene files: a machine and the analyses wanted, in one TOML file, run end to end.
 
 One direction, no circles: quantities with units (:mod:`.units`) → strict reading of a
 table (:mod:`.reader`) → the tables of parts' meshes (:mod:`.mesh`), mechanisms and

@@ -16,7 +16,7 @@ tripped when its force reaches a limit and braked to rest, for several braking t
 one unit in which the scene's charts, tables and report show drive speeds; it is copied
 into the sweep, stability and response specs.
 
-Stage 7 (scene), reading: uses scene.reader, scene.units, scene.machine (what a built-in
+Stage 8 (scene), reading: uses scene.reader, scene.units, scene.machine (what a built-in
 mechanism's coordinates are), the defaults of analysis.response and analysis.magnus,
 analysis.nonlinear (the integrators), analysis.drive_events (travel time) and
 output.charts (how a speed is labelled).

@@ -10,7 +10,7 @@ steps that :mod:`femmech.scene.run` calls only when an analysis needs them. Erro
 raised here are re-raised as one-line :class:`~femmech.errors.SceneError` naming the
 scene location.
 
-Stage 7 (scene), plan and build: uses scene.load, scene.mechanisms, fe, reduction and
+Stage 8 (scene), plan and build: uses scene.load, scene.mechanisms, fe, reduction and
 coupling.
 """
 

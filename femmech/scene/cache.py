@@ -1,4 +1,4 @@
-"""Stage 7: on-disk cache of reductions (superelements), keyed by a hash of what they depend on.
+"""Stage 8: on-disk cache of reductions (superelements), keyed by a hash of what they depend on.
 
 The key is the SHA-256 of everything a reduction depends on
 (:func:`femmech.scene.build.reduction_key_data`). An entry is the superelement file, its

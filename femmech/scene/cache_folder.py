@@ -1,4 +1,4 @@
-"""Stage 7: the folder of the reduction cache: its files, stale temporaries, size, eviction.
+"""Stage 8: the folder of the reduction cache: its files, stale temporaries, size, eviction.
 
 The cache folder holds, per key (64 hex digits), only these files; any other file is
 foreign and left alone:

@@ -12,7 +12,7 @@ Values are plain numbers in SI units or strings with units (``"210 GPa"``, see
 :mod:`femmech.scene.units`). The format is described in ``docs/scenes.md``. Every error is a
 one-line :class:`~femmech.errors.SceneError` naming the file, the key and the expectation.
 
-Stage 7 (scene), validation: uses the table readers (scene.reader, .mesh, .machine,
+Stage 8 (scene), validation: uses the table readers (scene.reader, .mesh, .machine,
 .analyses), fe.sections and fe.dofs; the result is plain data, nothing is built.
 """
 

@@ -9,7 +9,7 @@ are built: ``rheolinear`` (the default; mounts, sweeps) or ``second_kind`` (the 
 equations with prescribed drives; drive events). A mount places a mechanism on a part:
 :class:`femmech.coupling.Mount`.
 
-Stage 7 (scene), reading: uses scene.reader, scene.units, fe.dofs and the factories of
+Stage 8 (scene), reading: uses scene.reader, scene.units, fe.dofs and the factories of
 mechanisms; nothing is built here.
 """
 

@@ -6,7 +6,7 @@ opts in (``allow_code=True``, ``femmech run --allow-code``), and only from a fil
 the allowed root (the scene's folder unless the caller names another, ``code_root``).
 See the threat model in docs/robustness.md.
 
-Stage 7 (scene), build: uses scene.load, scene.machine and mechanisms.
+Stage 8 (scene), build: uses scene.load, scene.machine and mechanisms.
 """
 
 from __future__ import annotations

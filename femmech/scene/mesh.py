@@ -5,7 +5,7 @@ against :data:`femmech.fe.mesh.MAX_NODES` and ``MAX_CELLS`` before anything is a
 members may not overlap and their elements may not be shorter than the near-node distance
 of :mod:`femmech.fe.checks`.
 
-Stage 7 (scene), reading: uses scene.reader, scene.units and fe (generators' sizes,
+Stage 8 (scene), reading: uses scene.reader, scene.units and fe (generators' sizes,
 mesh checks); nothing is built here.
 """
 

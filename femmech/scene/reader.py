@@ -9,7 +9,7 @@ a misspelt key is reported, with a "did you mean", before any missing or inconsi
 value. :func:`check_limits` bounds the size of everything a scene can hand over (nesting
 depth, list and string lengths, number of values) before any of it is read.
 
-Stage 7 (scene), reading: uses scene.units and fe.mesh (limits on mesh sizes).
+Stage 8 (scene), reading: uses scene.units and fe.mesh (limits on mesh sizes).
 """
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ unreduced coupled machine is built only for the full-versus-reduced check. Resul
 the report page (``report.html``), ``results.json`` (key numbers, no timings: identical
 for identical inputs), ``run.log`` and the files of each analysis.
 
-Stage 7 (scene), the top: uses scene.tasks, scene.workshop, scene.build, the cache and
+Stage 8 (scene), the top: uses scene.tasks, scene.workshop, scene.build, the cache and
 output; only femmech.cli and the package's __init__ import it.
 """
 

@@ -15,7 +15,7 @@ the natural modes, and the appendix.
 
 Numbers are formatted by :mod:`femmech.output.formatting` (units in cells or headers).
 
-Stage 7 (scene), report: uses scene.load, scene.machine, scene.units, fe, analysis
+Stage 8 (scene), report: uses scene.load, scene.machine, scene.units, fe, analysis
 (participation, modes), reduction, solve (direct, threads) and output (report,
 formatting); receives the run's :class:`~femmech.scene.workshop.Workshop`.
 """

@@ -5,7 +5,7 @@ Each task takes ``(workshop, spec, out)``; see :mod:`femmech.scene.run` for the 
 (lazy FE models, cached reductions, coupled machines) and :mod:`femmech.scene.analyses`
 for the specs.
 
-Stage 7 (scene), compute and write: uses scene.workshop, scene.build, analysis, output,
+Stage 8 (scene), compute and write: uses scene.workshop, scene.build, analysis, output,
 coupling and mechanisms.
 """
 

@@ -9,7 +9,7 @@ Dimensions are exponents of (kg, m, s, rad). The radian is kept as its own dimen
 that an angular speed (rad/s, rpm) is never confused with a frequency (Hz = 1/s), which
 differ by 2π; a rotational stiffness is therefore written ``N*m/rad``.
 
-Stage 7 (scene), reading: imports nothing of femmech.
+Stage 8 (scene), reading: imports nothing of femmech.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ reduction is loaded from the cache when the key matches (:mod:`femmech.scene.cac
 the unreduced coupled machine is built only for the full-versus-reduced check. The
 analyses (:mod:`femmech.scene.tasks`) take a workshop and ask it for what they need.
 
-Stage 7 (scene), compute: uses scene.build, scene.cache, fe, reduction, coupling and
+Stage 8 (scene), compute: uses scene.build, scene.cache, fe, reduction, coupling and
 output.report.
 """
 
