@@ -33,7 +33,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from femmech.analysis.magnus import MAX_STEPS, RTOL, Monodromy, integrate_monodromy
-from femmech.analysis.sweep import sweep
+from femmech.analysis.sweep import frozen_modes, sweep
 from femmech.coupling import (
     CoupledSystem,
     assemble_stack,
@@ -268,14 +268,58 @@ def coupled_monodromy_record(system, Omega, n_steps, angle_period, phi0, basis, 
                                breaks)
 
 
+UNDAMPED_RTOL = 1e-9
+"""A quasi-mode counts as undamped when its modal damping |vᵀ B_sym v| (v mass-normalised)
+is at most UNDAMPED_RTOL · 2ω (damping ratio below 1e-9)."""
+
+
 def coupled_floquet(system: CoupledSystem, Omega: float, n_steps: int = 32,
                     angle_period: float = 2 * np.pi, tol: float = 1e-6,
                     basis: np.ndarray | None = None, rtol: float | None = RTOL,
-                    max_steps: int = MAX_STEPS) -> Floquet:
-    """:func:`floquet` of :func:`coupled_monodromy` (period Θ/Ω), with its check."""
+                    max_steps: int = MAX_STEPS, allow_undamped: bool = False) -> Floquet:
+    """:func:`floquet` of :func:`coupled_monodromy` (period Θ/Ω), with its check.
+
+    Without a ``basis``, a system with an undamped quasi-mode (at every one of 4 angles
+    over the cycle; typically an undamped frame whose modes no mechanism damper moves)
+    is refused with a ``ValueError``: each such mode has the multipliers |μ| = 1, so the
+    spectral radius is 1 up to the integration error of the (stiff) undamped modes,
+    whatever the damped mechanism motion does, and the verdict ``ρ <= 1 + tol`` then
+    reads that error (tests/mechanisms/test_gaps_floquet.py: ρ = 1 + 2.8e-6, "unstable",
+    for a cam on an undamped beam at 5 rad/s). Give the frame damping
+    (:func:`femmech.analysis.response.rayleigh_damping`), a Ritz ``basis`` of the motions
+    to judge, or ``allow_undamped=True`` for the conservative system's ρ as it is.
+    """
+    if basis is None and not allow_undamped:
+        _refuse_undamped(system, Omega, angle_period)
     record = coupled_monodromy(system, Omega, n_steps, angle_period, basis=basis,
                                rtol=rtol, max_steps=max_steps, full_output=True)
     return floquet(record, angle_period / Omega, tol)
+
+
+def _refuse_undamped(system: CoupledSystem, Omega: float, angle_period: float) -> None:
+    """Raise ValueError if every one of 4 angles has an undamped quasi-mode
+    (modes of C(φ, 0) v = λ M(φ) v, damping from the symmetric part of B(φ, Ω))."""
+    require_dense_primal(system, "coupled_floquet")
+    found = []
+    for phi in np.arange(4) * (angle_period / 4):
+        M, _, C, _ = system.matrices(phi, 0.0)
+        B = system.matrices(phi, Omega)[1]
+        _, freq, _, V, _ = frozen_modes(M, None, C, system.n)
+        V = V.real
+        damping = np.abs(np.einsum("ij,ij->j", V, 0.5 * (B + B.T) @ V))
+        undamped = damping <= UNDAMPED_RTOL * 4 * np.pi * np.abs(freq)
+        if not undamped.any():
+            return
+        found.append(freq[undamped])
+    listed = ", ".join(f"{f:.4g}" for f in found[0][:6])
+    raise ValueError(
+        f"coupled_floquet: {found[0].size} quasi-mode(s) of the system are undamped"
+        f" (at phi = 0: {listed} Hz; frame without damping?). Their Floquet multipliers"
+        " lie on the unit circle, so the spectral radius is 1 up to integration error"
+        " whatever the mechanisms do, and the stability verdict would read that error."
+        " Add frame damping (femmech.analysis.response.rayleigh_damping), pass"
+        " basis= spanning the motions to judge, or allow_undamped=True for the"
+        " conservative system's spectral radius as it is")
 
 
 def _checked_basis(basis, n: int) -> np.ndarray:

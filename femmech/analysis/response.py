@@ -41,6 +41,7 @@ from femmech.errors import ConvergenceWarning
 from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
 from femmech.fe.model import node_index
 from femmech.html import Flag, html_summary
+from femmech.mechanisms.motion_laws import motion_law
 
 
 @dataclass(frozen=True)
@@ -113,8 +114,13 @@ class SpeedRamp:
     """Smooth speed change (run-up or braking) from Ω_start to Ω_end.
 
     Ω(t) = Ω_s + (Ω_e - Ω_s) s(τ), τ = (t - t_start)/duration, with the cycloidal ramp
-    s(τ) = τ - sin(2πτ)/(2π): the drive acceleration Ω̇ rises from and returns to zero
-    (no jerk steps). Constant speeds before and after.
+    s(τ) = τ - sin(2πτ)/(2π) by default: the drive acceleration Ω̇ rises from and
+    returns to zero (no jerk steps). Constant speeds before and after. Any cam motion
+    law can shape the ramp instead (``law``: a name of
+    :data:`femmech.mechanisms.motion_laws.LAWS` or a law object): then
+    Ω̇ = (Ω_e - Ω_s) s'(τ)/duration and φ takes ``duration · ∫₀^τ s``; with
+    ``"harmonic"`` Ω̇ jumps at both ends, with ``"polynomial_4567"`` even its rate is
+    continuous. :meth:`breakpoints` gives the times where a derivative of Ω may jump.
 
     Attributes
     ----------
@@ -126,6 +132,8 @@ class SpeedRamp:
         Ramp start, s.
     phi0 : float
         Drive angle at t = 0, rad.
+    law : str or motion law
+        Shape s(τ) of the ramp, ``"cycloidal"`` by default.
     """
 
     Omega_start: float
@@ -133,6 +141,16 @@ class SpeedRamp:
     duration: float
     t_start: float = 0.0
     phi0: float = 0.0
+    law: object = "cycloidal"
+
+    def __post_init__(self):
+        motion_law(self.law)  # an unknown name fails here, listing the known ones
+
+    def breakpoints(self) -> np.ndarray:
+        """Times, s, where Ω̇ or its rate may jump: the ramp's ends and the piece joints
+        of a piecewise law (integrators align their steps with them)."""
+        inner = motion_law(self.law).joints()
+        return self.t_start + self.duration * np.concatenate([[0.0], inner, [1.0]])
 
     def __call__(self, t):
         """φ, Ω, Ω̇ at times t (n_t,) → three arrays (n_t,)."""
@@ -141,13 +159,19 @@ class SpeedRamp:
         t = np.asarray(t, dtype=float)
         d, dW = self.duration, self.Omega_end - self.Omega_start
         tau = np.clip((t - self.t_start) / d, 0.0, 1.0)
-        s = tau - np.sin(2 * np.pi * tau) / (2 * np.pi)
-        # ∫₀^τ s dτ' · d = d [τ²/2 + (cos 2πτ - 1)/(4π²)]
-        ramp_angle = d * (tau**2 / 2 + (np.cos(2 * np.pi * tau) - 1) / (4 * np.pi**2))
+        if isinstance(self.law, str) and self.law == "cycloidal":
+            s = tau - np.sin(2 * np.pi * tau) / (2 * np.pi)
+            # ∫₀^τ s dτ' · d = d [τ²/2 + (cos 2πτ - 1)/(4π²)]
+            ramp_angle = d * (tau**2 / 2 + (np.cos(2 * np.pi * tau) - 1) / (4 * np.pi**2))
+            rate = 1 - np.cos(2 * np.pi * tau)
+        else:
+            law = motion_law(self.law)
+            s, rate, _, _ = law.evaluate(tau)
+            ramp_angle = d * law.integral(tau)
         after = np.clip(t - self.t_start - d, 0.0, None)
         phi = self.phi0 + self.Omega_start * t + dW * (ramp_angle + after)
         Omega = self.Omega_start + dW * s
-        Omega_dot = dW / d * (1 - np.cos(2 * np.pi * tau)) * ((tau > 0) & (tau < 1))
+        Omega_dot = dW / d * rate * ((tau > 0) & (tau < 1))
         return phi, Omega, Omega_dot
 
 

@@ -251,9 +251,13 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
 
     Parameters
     ----------
-    system : CoupledSystem
-        With a reduced (dense) frame; for an unreduced frame use
-        :func:`femmech.analysis.reference.full_modes`.
+    system : CoupledSystem or mechanism model
+        A coupled machine with a reduced (dense) frame (for an unreduced frame use
+        :func:`femmech.analysis.reference.full_modes`), or a mechanism alone: any object
+        with ``M(phi)``, ``B(phi, Omega)`` and ``C(phi, Omega, Omega_dot)`` that map
+        angles of shape S to matrices S + (n, n) (a
+        :class:`~femmech.mechanisms.RheolinearModel` with one drive, or a chain model);
+        see :func:`_sweep_model`. A model may track all its n branches.
     phi : array_like (n_angles,)
         Drive angles, rad, in sweep order (e.g. ``np.linspace(0, 2π, 361)``).
     Omega, Omega_dot : float
@@ -278,6 +282,9 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
     -------
     Sweep
     """
+    if not isinstance(system, CoupledSystem):
+        return _sweep_model(system, phi, Omega, Omega_dot, n_modes, damped, track,
+                            keep_vectors, frequency_weight, blas_threads)
     if system.is_sparse:
         raise ValueError("sweep needs a reduced frame (Superelement or Assembly of"
                          " superelements); use femmech.analysis.reference.full_modes for"
@@ -290,6 +297,48 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
     with _solve_phase(blas_threads):
         return _sweep_loop(matrices, system.n, system.H, phi, n_modes, extra, damped, track,
                            keep_vectors, frequency_weight)
+
+
+def _sweep_model(model, phi, Omega, Omega_dot, n_modes, damped, track, keep_vectors,
+                 frequency_weight, blas_threads) -> Sweep:
+    """:func:`sweep` of a mechanism model alone (no frame, no constraints).
+
+    The model is a duck type: ``M(phi)``, ``B(phi, Omega)`` (read only if ``damped``)
+    and ``C(phi, Omega, Omega_dot)``, each called once with all angles (n_angles,) and
+    returning (n_angles, n, n); ``n`` (if present) is checked against the matrices.
+    """
+    if not all(callable(getattr(model, name, None)) for name in ("M", "B", "C")):
+        raise TypeError("sweep needs a CoupledSystem or a mechanism model with M(phi),"
+                        " B(phi, Omega) and C(phi, Omega, Omega_dot), got"
+                        f" {type(model).__name__}")
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    if phi.ndim != 1:
+        raise ValueError(f"phi must be 1-D (one drive), got shape {phi.shape}")
+    matrices, n = _model_matrices(model, phi, Omega, Omega_dot, damped)
+    if int(n_modes) != n_modes or not 0 < n_modes <= n:
+        raise ValueError(f"n_modes must be an integer in 1..{n}, got {n_modes}")
+    extra = min(int(n_modes) + max(2, int(n_modes) // 2), n)
+    with _solve_phase(blas_threads):
+        return _sweep_loop(matrices, n, None, phi, int(n_modes), extra, damped, track,
+                           keep_vectors, frequency_weight)
+
+
+def _model_matrices(model, phi, Omega, Omega_dot, damped: bool):
+    """``(matrices(a) -> (M, B, C), n)`` of a mechanism model, evaluated for all angles
+    in one vectorised call per matrix; B is None unless ``damped``."""
+    stacks = {"M": model.M(phi), "C": model.C(phi, Omega, Omega_dot)}
+    if damped:
+        stacks["B"] = model.B(phi, Omega)
+    stacks = {k: np.asarray(v, dtype=float) for k, v in stacks.items()}
+    n = stacks["M"].shape[-1] if stacks["M"].ndim else 0
+    for name, X in stacks.items():
+        if X.shape != (phi.size, n, n):
+            raise ValueError(f"the model's {name}(phi) has shape {X.shape} for"
+                             f" {phi.size} angles, expected ({phi.size}, n, n)")
+    if getattr(model, "n", n) != n:
+        raise ValueError(f"the model says n = {model.n} but M(phi) is {n} x {n}")
+    B = stacks.get("B")
+    return (lambda a: (stacks["M"][a], None if B is None else B[a], stacks["C"][a])), n
 
 
 def parameter_sweep(system_at, values, phi: float = 0.0, n_modes: int = 6,

@@ -118,6 +118,7 @@ class Chain:
     attach: int = 0
     x: np.ndarray = None
     _index: tuple = field(init=False, repr=False)
+    _shaft_matrices: tuple = field(init=False, repr=False)
 
     def __post_init__(self):
         J = _vector("node_inertia", self.node_inertia, lower=0.0)
@@ -155,6 +156,7 @@ class Chain:
                             ("clamped", clamped), ("x", x)):
             object.__setattr__(self, name, value)
         object.__setattr__(self, "_index", _dof_index(self))
+        object.__setattr__(self, "_shaft_matrices", self._shaft())
 
     @property
     def n_nodes(self) -> int:
@@ -204,30 +206,52 @@ class Chain:
         N m s/rad or N s/m, as the unit's coordinates give.
         """
         Mu, Bu, Cu = self.unit_matrices(float(phi), Omega, Omega_dot)
-        shaft_M, shaft_C = self._shaft()
+        shaft_M, shaft_C = self._shaft_matrices
         shaft_B = sp.coo_matrix((self.n, self.n))
         return tuple((shaft + self._scatter(U)).tocsr() for shaft, U in
                      ((shaft_M, Mu), (shaft_B, Bu), (shaft_C, Cu)))
 
     def M(self, phi) -> np.ndarray:
         """Dense assembled mass matrix, S + (n, n), for small chains (sweeps)."""
-        return self._dense(phi, 0)
+        angle = np.asarray(phi, dtype=float)
+        return self._dense(angle, self.unit.M(angle[..., None] + self.phase),
+                           self._shaft_matrices[0])
 
     def B(self, phi, Omega) -> np.ndarray:
         """Dense assembled damping matrix, S + (n, n)."""
-        return self._dense(phi, 1, Omega)
+        angle = np.asarray(phi, dtype=float)
+        return self._dense(angle, self.unit.B(angle[..., None] + self.phase, Omega), None)
 
     def C(self, phi, Omega=0.0, Omega_dot=0.0) -> np.ndarray:
         """Dense assembled stiffness matrix, S + (n, n)."""
-        return self._dense(phi, 2, Omega, Omega_dot)
+        angle = np.asarray(phi, dtype=float)
+        blocks = self.unit.C(angle[..., None] + self.phase, Omega, Omega_dot)
+        return self._dense(angle, blocks, self._shaft_matrices[1])
 
-    def _dense(self, phi, which: int, Omega=0.0, Omega_dot=0.0) -> np.ndarray:
-        phi = np.asarray(phi, dtype=float)
-        flat = phi.reshape(-1)
-        out = np.empty((flat.size, self.n, self.n))
-        for a, angle in enumerate(flat):
-            out[a] = self.sparse_matrices(angle, Omega, Omega_dot)[which].toarray()
-        return out.reshape(phi.shape + (self.n, self.n))
+    def F(self, phi, Omega=0.0, Omega_dot=0.0) -> np.ndarray:
+        """Assembled force vector, S + (n,): the units' F(φ + δ_u, Ω, Ω̇) (the shaft
+        carries no load; components on clamped rotations are dropped)."""
+        angle = np.asarray(phi, dtype=float)
+        Fu = self.unit.F(angle[..., None] + self.phase, Omega, Omega_dot)  # S+(N, m)
+        flat = Fu.reshape(-1, self.n_units * self.m)
+        dofs = self.unit_dofs.reshape(-1)
+        keep = dofs >= 0
+        out = np.zeros((flat.shape[0], self.n))
+        np.add.at(out, (slice(None), dofs[keep]), flat[:, keep])
+        return out.reshape(angle.shape + (self.n,))
+
+    def _dense(self, angle, blocks, shaft) -> np.ndarray:
+        """Dense (S + (n, n)) assembly of unit blocks S + (n_units, m, m) plus a shaft part."""
+        flat = blocks.reshape((-1,) + blocks.shape[-3:])
+        out = np.zeros((flat.shape[0], self.n, self.n))
+        if shaft is not None:
+            out += shaft.toarray()
+        dofs = self.unit_dofs
+        r = np.broadcast_to(dofs[:, :, None], flat.shape[1:])
+        c = np.broadcast_to(dofs[:, None, :], flat.shape[1:])
+        keep = (r >= 0) & (c >= 0)
+        np.add.at(out, (slice(None), r[keep], c[keep]), flat[:, keep])
+        return out.reshape(angle.shape + (self.n, self.n))
 
     def _shaft(self):
         """Shaft mass and stiffness (n, n) sparse: node inertias, segments, ground."""

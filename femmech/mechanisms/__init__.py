@@ -12,6 +12,7 @@ C stiffness, F force.
 * :mod:`.evaluate`: vectorised numerical evaluation of the symbolic equations.
 * :mod:`.models`: numerical mechanism models (rheolinear, 2nd kind, mixed type).
 * :mod:`.quasi_modes`: quasi-eigenfrequencies and quasi-modes at frozen drive angles.
+* :mod:`.statics`: static equilibrium (operating point) under gravity and preload.
 * :mod:`.mounted`: mechanisms whose bearings and guides move with an elastic frame.
 * :mod:`.chapter`: built-in models of the seed chapter (Table 5.1, 5.2.3.1, 5.2.3.2).
 
@@ -50,11 +51,14 @@ from femmech.mechanisms.motion_laws import (
     MotionLaw,
     PolynomialLaw,
     SinusoidalLaw,
+    cam_program,
     cycloidal,
     harmonic,
     modified_sine,
     modified_trapezoid,
+    motion_law,
     polynomial_345,
+    polynomial_4567,
 )
 from femmech.mechanisms.mounted import cam_follower, slider_crank
 from femmech.mechanisms.position import PositionFunction
@@ -63,6 +67,7 @@ from femmech.mechanisms.quasi_modes import (
     frozen_eigen,
     quasi_modes,
 )
+from femmech.mechanisms.statics import StaticEquilibrium, static_equilibrium
 from femmech.mechanisms.symbolic import (
     Damper,
     Load,
@@ -100,8 +105,10 @@ __all__ = [
     "SinusoidalLaw",
     "SliderCrank",
     "Spring",
+    "StaticEquilibrium",
     "TabulatedPositionFunction",
     "cam_follower",
+    "cam_program",
     "cycloidal",
     "frozen_eigen",
     "harmonic",
@@ -111,7 +118,9 @@ __all__ = [
     "mobile_crane_parameters",
     "modified_sine",
     "modified_trapezoid",
+    "motion_law",
     "polynomial_345",
+    "polynomial_4567",
     "position_function",
     "processing_machine",
     "processing_machine_cams",
@@ -122,6 +131,7 @@ __all__ = [
     "rheolinear_terms",
     "second_kind",
     "slider_crank",
+    "static_equilibrium",
     "table_5_1_case",
     "velocity_symbol",
 ]

@@ -10,9 +10,17 @@ respect to z. A *cam programme* (:class:`CamProfile`) strings segments of angula
 which gives a position function U(φ) with exact derivatives U', U'', U''' (see
 :mod:`femmech.mechanisms.position`).
 
-All laws except the 3-4-5 polynomial have a piecewise sinusoidal acceleration
-a(z) = c + A sin(ω(z − z_k) + θ) on pieces [z_k, z_k+1]; they are integrated in closed
-form, so every derivative is exact to round-off.
+All laws except the polynomials (3-4-5, 4-5-6-7) have a piecewise sinusoidal
+acceleration a(z) = c + A sin(ω(z − z_k) + θ) on pieces [z_k, z_k+1]; they are
+integrated in closed form, so every derivative is exact to round-off.
+
+Laws by name: :data:`LAWS` and :func:`motion_law`. A rise–dwell–return–dwell programme
+from its angles in degrees and its stroke: :func:`cam_program` (also
+:meth:`CamProfile.from_program`). Every profile lists the angles where a derivative of
+U may jump (:meth:`CamProfile.breakpoints`: the segment joints and the piece joints
+inside the piecewise laws); the cycle integrators (:mod:`femmech.analysis.magnus`)
+start a step at each of them, because a step across a jump loses the order of the
+scheme.
 
 References
 ----------
@@ -35,11 +43,15 @@ __all__ = [
     "MotionLaw",
     "PolynomialLaw",
     "SinusoidalLaw",
+    "LAWS",
+    "cam_program",
     "cycloidal",
     "harmonic",
     "modified_sine",
     "modified_trapezoid",
+    "motion_law",
     "polynomial_345",
+    "polynomial_4567",
 ]
 
 TWO_PI = 2.0 * np.pi
@@ -74,6 +86,10 @@ class PolynomialLaw:
         z = np.asarray(z, dtype=float)
         poly = np.polynomial.Polynomial(self.coefficients)
         return tuple(poly.deriv(k)(z) if k else poly(z) for k in range(4))
+
+    def integral(self, z) -> np.ndarray:
+        """Return ``∫₀^z s(u) du`` at normalised angles ``z`` (any shape, in [0, 1])."""
+        return np.polynomial.Polynomial(self.coefficients).integ()(np.asarray(z, dtype=float))
 
     def joints(self) -> np.ndarray:
         """Normalised angles in (0, 1) where s, ..., s''' jump: none (a polynomial)."""
@@ -130,6 +146,29 @@ class SinusoidalLaw:
         s1 = v0 + c * d - a / w * (np.cos(x) - np.cos(th))
         s = s0 + v0 * d + 0.5 * c * d**2 - a / w * ((np.sin(x) - np.sin(th)) / w - d * np.cos(th))
         return s, s1, s2, s3
+
+    def _piece_integral(self, k, d) -> np.ndarray:
+        """``∫₀^d s(z_k + u) du`` on piece(s) k (int array) for lengths d (same shape).
+
+        With x = ω d + θ, the integral of :meth:`evaluate`'s s:
+        s_k d + v_k d²/2 + c d³/6 − (A/ω)[(cos θ − cos x)/ω² − d sin θ/ω − d² cos θ/2].
+        """
+        c, a, w, th = (np.asarray(p)[k] for p in (self.const, self.amp, self.omega, self.phase))
+        s0, v0 = np.asarray(self.s_start)[k], np.asarray(self.v_start)[k]
+        x = w * d + th
+        return (s0 * d + 0.5 * v0 * d**2 + c * d**3 / 6
+                - a / w * ((np.cos(th) - np.cos(x)) / w**2 - d * np.sin(th) / w
+                           - 0.5 * d**2 * np.cos(th)))
+
+    def integral(self, z) -> np.ndarray:
+        """Return ``∫₀^z s(u) du`` at normalised angles ``z`` (any shape, in [0, 1])."""
+        z = np.asarray(z, dtype=float)
+        starts = np.asarray(self.starts)
+        pieces = np.arange(starts.size)
+        lengths = np.diff(np.append(starts, 1.0))
+        before = np.concatenate([[0.0], np.cumsum(self._piece_integral(pieces, lengths))])
+        k = np.clip(np.searchsorted(starts, z, side="right") - 1, 0, starts.size - 1)
+        return before[k] + self._piece_integral(k, z - starts[k])
 
     def joints(self) -> np.ndarray:
         """Normalised angles in (0, 1) of the interior piece boundaries (s''' may jump)."""
@@ -201,7 +240,43 @@ def polynomial_345() -> PolynomialLaw:
     return PolynomialLaw("3-4-5 polynomial", (0.0, 0.0, 0.0, 10.0, -15.0, 6.0), continuity=2)
 
 
+def polynomial_4567() -> PolynomialLaw:
+    """Return the 4-5-6-7 law s = 35z⁴ − 84z⁵ + 70z⁶ − 20z⁷; jerk continuous (C³).
+
+    The polynomial of degree 7 with s(0) = 0, s(1) = 1 and s', s'', s''' zero at both
+    ends (Norton [1]_, sec. 3.10; Rothbart [2]_, ch. 2).
+    """
+    return PolynomialLaw("4-5-6-7 polynomial", (0.0, 0.0, 0.0, 0.0, 35.0, -84.0, 70.0, -20.0),
+                         continuity=3)
+
+
 MotionLaw = PolynomialLaw | SinusoidalLaw
+
+LAWS = {"cycloidal": cycloidal, "harmonic": harmonic, "modified_sine": modified_sine,
+        "modified_trapezoid": modified_trapezoid, "polynomial_345": polynomial_345,
+        "polynomial_4567": polynomial_4567}
+"""The motion laws by name (their constructors); :func:`motion_law` also accepts
+"3-4-5", "4-5-6-7", and spaces or hyphens for underscores ("modified sine")."""
+
+_ALIASES = {"3_4_5": "polynomial_345", "345": "polynomial_345", "4_5_6_7": "polynomial_4567",
+            "4567": "polynomial_4567", "simple_harmonic": "harmonic"}
+
+
+def motion_law(law) -> MotionLaw:
+    """Return a motion law given by name (a key of :data:`LAWS`) or as a law object.
+
+    Raises ``ValueError`` for an unknown name, listing the known ones.
+    """
+    if isinstance(law, PolynomialLaw | SinusoidalLaw):
+        return law
+    if not isinstance(law, str):
+        raise TypeError(f"a motion law is a name or a law object, got {type(law).__name__}")
+    key = law.strip().lower().replace("-", "_").replace(" ", "_")
+    key = _ALIASES.get(key, key)
+    if key not in LAWS:
+        raise ValueError(f"unknown motion law {law!r}; known laws: {', '.join(LAWS)}"
+                         " (also '3-4-5', '4-5-6-7')")
+    return LAWS[key]()
 
 
 @dataclass(frozen=True)
@@ -281,6 +356,14 @@ class CamProfile:
         starts = np.concatenate([[0.0], np.cumsum([s.beta for s in self.segments])[:-1]])
         object.__setattr__(self, "_starts", tuple(starts))
 
+    @classmethod
+    def from_program(cls, stroke: float, rise: float, dwell_top: float, return_: float,
+                     dwell_bottom: float = 0.0, law="cycloidal", return_law=None,
+                     start: float = 0.0, base: float = 0.0) -> "CamProfile":
+        """Rise–dwell–return–dwell programme, angles in degrees: :func:`cam_program`."""
+        return cam_program(stroke, rise, dwell_top, return_, dwell_bottom, law, return_law,
+                           start, base)
+
     def derivatives(self, phi) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Return ``(U, U', U'', U''')`` at drive angles ``phi`` (rad, any shape).
 
@@ -319,3 +402,62 @@ class CamProfile:
             if seg.law is not None and seg.lift != 0:
                 angles.append(start + seg.beta * seg.law.joints())
         return np.unique(np.mod(self.phi_start + np.concatenate(angles), TWO_PI))
+
+
+def cam_program(stroke: float, rise: float, dwell_top: float, return_: float,
+                dwell_bottom: float = 0.0, law="cycloidal", return_law=None,
+                start: float = 0.0, base: float = 0.0) -> CamProfile:
+    """Rise–dwell–return–dwell cam programme from its angles in degrees.
+
+    The follower rises by ``stroke`` over ``rise`` degrees with ``law``, dwells at the
+    top for ``dwell_top``, returns over ``return_`` with ``return_law`` (default: the
+    rise law) and dwells at the bottom for ``dwell_bottom``. Zero dwells are left out
+    (rise and return then meet; :meth:`CamProfile.breakpoints` lists every joint).
+
+    Parameters
+    ----------
+    stroke : float
+        Lift of the follower, m (translating) or rad (rocker), non-zero; negative for a
+        programme that falls first.
+    rise, dwell_top, return_, dwell_bottom : float
+        Segment angles, degrees (deg): rise and return > 0, dwells >= 0, sum 360.
+    law, return_law : str or MotionLaw
+        A name of :data:`LAWS` (``"cycloidal"``, ``"harmonic"``, ``"modified_sine"``,
+        ``"modified_trapezoid"``, ``"polynomial_345"``, ``"polynomial_4567"``) or a law.
+    start : float
+        Drive angle where the rise starts, degrees.
+    base : float
+        Follower position in the bottom dwell (m or rad).
+
+    Returns
+    -------
+    CamProfile
+
+    Examples
+    --------
+    >>> cam = cam_program(0.02, rise=90, dwell_top=90, return_=90, dwell_bottom=90)
+    >>> [round(float(x), 6) for x in np.rad2deg(cam.breakpoints())]
+    [0.0, 90.0, 180.0, 270.0]
+    """
+    angles = {"rise": rise, "dwell_top": dwell_top, "return_": return_,
+              "dwell_bottom": dwell_bottom}
+    for name, value in angles.items():
+        if not np.isfinite(value) or value < 0:
+            raise ValueError(f"cam programme: {name} must be a finite angle >= 0 deg,"
+                             f" got {value}")
+    for name in ("rise", "return_"):
+        if angles[name] == 0:
+            raise ValueError(f"cam programme: {name} must be > 0 deg")
+    total = sum(angles.values())
+    if abs(total - 360.0) > 1e-9:
+        raise ValueError(f"cam programme: the angles rise + dwell_top + return_ +"
+                         f" dwell_bottom sum to {total!r} deg, not 360 (difference"
+                         f" {total - 360.0:.3g} deg)")
+    if not (np.isfinite(stroke) and stroke != 0):
+        raise ValueError(f"cam programme: stroke must be finite and non-zero, got {stroke}")
+    up, down = motion_law(law), motion_law(law if return_law is None else return_law)
+    pieces = ((rise, stroke, up), (dwell_top, 0.0, None), (return_, -stroke, down),
+              (dwell_bottom, 0.0, None))
+    segments = tuple(CamSegment(np.deg2rad(beta), lift, f) for beta, lift, f in pieces
+                     if beta > 0)
+    return CamProfile(segments, phi_start=np.deg2rad(start), base=base)

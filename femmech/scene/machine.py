@@ -28,6 +28,7 @@ from femmech.mechanisms import (
     slider_crank,
     table_5_1_case,
 )
+from femmech.mechanisms.motion_laws import LAWS
 from femmech.scene.reader import Reader, show
 from femmech.scene.units import (
     ACCELERATION,
@@ -102,7 +103,8 @@ coordinate names, ``"force <drive>"`` (the force a drive supplies) and ``"spring
 (the force of the k-th spring, 1-based in the mechanism's element order)."""
 
 POSITION_KINDS = ("cam", "slider_crank", "four_bar", "chapter_cam")
-MOTION_LAWS = ("polynomial_345", "cycloidal", "harmonic", "modified_sine", "modified_trapezoid")
+MOTION_LAWS = tuple(LAWS)
+"""Names of the cam motion laws a scene may use (:data:`femmech.mechanisms.motion_laws.LAWS`)."""
 
 
 @dataclass(frozen=True)

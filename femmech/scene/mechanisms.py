@@ -25,21 +25,13 @@ from femmech.mechanisms import (
     RheolinearModel,
     SliderCrank,
     Spring,
-    cycloidal,
-    harmonic,
-    modified_sine,
-    modified_trapezoid,
-    polynomial_345,
     processing_machine_cams,
     rheolinear,
     second_kind,
 )
+from femmech.mechanisms.motion_laws import LAWS
 from femmech.scene.load import fail
 from femmech.scene.machine import BUILTIN_MODELS
-
-LAWS = {"polynomial_345": polynomial_345, "cycloidal": cycloidal, "harmonic": harmonic,
-        "modified_sine": modified_sine, "modified_trapezoid": modified_trapezoid}
-
 
 FORM_BUILDERS = {"rheolinear": (rheolinear, RheolinearModel),
                  "second_kind": (second_kind, LagrangeModel)}
