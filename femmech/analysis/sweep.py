@@ -444,7 +444,7 @@ def _sweep_loop(matrices, n, H, phi, n_modes, extra, damped, track, keep_vectors
         M, B, C = matrices(a)
         ev, f, r, V, form = frozen_modes(M, B, C, extra, damped, H)
         groups = clusters(f) if track else None
-        while track and ev.size == extra < limit and _cuts_cluster(groups, f.size, n_modes):
+        while track and ev.size == extra < limit and cuts_cluster(groups, f.size, n_modes):
             extra = min(2 * extra, limit)  # complete the cluster (kept for later angles)
             ev, f, r, V, form = frozen_modes(M, B, C, extra, damped, H)
             groups = clusters(f)
@@ -454,7 +454,7 @@ def _sweep_loop(matrices, n, H, phi, n_modes, extra, damped, track, keep_vectors
                              f" {ev.size} modes")
         forms.add(form)
         if track and previous is not None:
-            pick, macs = _assign(previous, V, f, groups, M, frequency_weight)
+            pick, macs = assign_branches(previous, V, f, groups, M, frequency_weight)
         else:
             pick, macs = np.arange(n_modes), np.ones(n_modes)
         lam[a], freq[a], ratio[a], mac_step[a] = ev[pick], f[pick], r[pick], macs
@@ -468,8 +468,13 @@ def _sweep_loop(matrices, n, H, phi, n_modes, extra, damped, track, keep_vectors
     return Sweep(phi, freq, lam, ratio, vectors, mac_step, form)
 
 
-def _assign(previous, V, f, groups, M, weight):
+def assign_branches(previous, V, f, groups, M, weight):
     """Columns of V continuing each previous branch (Hungarian assignment).
+
+    ``previous = (V_prev (n, p), f_prev (p,))``, ``V`` (n, q) the new candidate vectors
+    and ``f`` (q,) their frequencies (Hz), ``M`` the (n, n) weighting matrix, ``weight``
+    the weight of the relative frequency jump. Returns ``(pick (p,), mac (p,))``: the
+    candidate column continuing each branch and its (subspace) MAC.
 
     The similarity of a previous branch i and a candidate j is the larger of two
     subspace MACs: of branch i with the span of j's cluster, and of j with the span of
@@ -494,7 +499,7 @@ def _assign(previous, V, f, groups, M, weight):
     return pick, sub[rows, pick]  # rows = 0..p-1 (p <= q: every branch is assigned)
 
 
-def _cuts_cluster(groups, n_candidates: int, n_modes: int) -> bool:
+def cuts_cluster(groups, n_candidates: int, n_modes: int) -> bool:
     """True if the last computed frequency is in the cluster of the n-th lowest: the
     candidates then hold only part of a cluster, whose span tracking needs whole.
     ``groups``: :func:`clusters` of the candidates (ascending, so the last group holds

@@ -356,7 +356,7 @@ def chain(unit, n_units: int, spacing: float, shaft_diameter: float, *,
     end_length : float, optional
         Length of an end stub, m (adds an end node at each end).
     cells : bool
-        Shaft inertia as identical cells (see above); needs ``n_units >= 2`` to matter.
+        Shaft inertia as identical cells (see above).
     station_inertia : float
         Inertia added at each unit node, kg m².
     phases : float or array_like (n_units,)
@@ -387,7 +387,8 @@ def chain(unit, n_units: int, spacing: float, shaft_diameter: float, *,
     first = 0 if end_length is None else 1
     unit_node = np.arange(first, first + n_units)
     if cells:  # the half spacing beyond each outer unit
-        J[unit_node[[0, -1]]] += Jseg / 2
+        J[unit_node[0]] += Jseg / 2
+        J[unit_node[-1]] += Jseg / 2
     J[unit_node] += station_inertia
     J[0] += left.inertia
     J[-1] += right.inertia

@@ -1,0 +1,224 @@
+"""Quasi-eigenfrequencies of a chain over the drive angle (slowly varying parameters),
+tracked branch by branch, by any of the chain methods side by side.
+
+* ``"transfer"`` (:func:`~femmech.chain.transfer.transfer_modes`) and ``"assembled"``
+  (:func:`~femmech.chain.transfer.assembled_modes`): branches are followed by the
+  mass-weighted MAC with frequency continuity, cluster-aware (the assignment of
+  :mod:`femmech.analysis.sweep`: a branch is compared with the span of a cluster of
+  close frequencies, so the arbitrary basis of a nearly repeated root cannot swap
+  branches, and the vector MAC within the cluster keeps crossing branches apart);
+* ``"cyclic"`` and ``"continuum"`` (:mod:`femmech.chain.cyclic`,
+  :mod:`femmech.chain.continuum`): each root carries a wave / mode number; a branch is
+  the pair (label, rank of the root within its label), fixed at the first angle.
+
+Stage 6 (chain): imports analysis (the Sweep result and its tracking pieces).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+
+from femmech.analysis.sweep import Sweep, assign_branches, clusters, cuts_cluster
+from femmech.chain.results import ChainModes
+from femmech.chain.transfer import assembled_modes, transfer_modes
+
+METHODS = ("transfer", "assembled", "cyclic", "continuum")
+"""Methods :func:`chain_sweep` knows."""
+
+REPEATED_RTOL = 1e-9
+"""Frequencies within this relative spread are one repeated root (its basis is aligned
+to the branches' previous vectors); the roots are accurate to ~1e-12."""
+
+
+def chain_sweep(chain, phi, n_modes: int, method: str = "transfer",
+                frequency_weight: float = 0.1, keep_vectors: bool = False) -> Sweep:
+    """Tracked quasi-eigenfrequencies of the frozen chain at the drive angles ``phi``.
+
+    Parameters
+    ----------
+    chain : Chain
+    phi : array_like (n_angles,)
+        Drive angles, rad, in sweep order (e.g. ``np.linspace(0, 2π, 181)``).
+    n_modes : int
+        Number of branches (the n lowest at the first angle).
+    method : str
+        One of :data:`METHODS`.
+    frequency_weight : float
+        Weight of the relative frequency jump against ``1 − MAC`` (MAC tracking).
+    keep_vectors : bool
+        Store the mode shapes (n_angles, n, n_modes) (methods with vectors).
+
+    Returns
+    -------
+    Sweep
+        ``form="symmetric"``; ``freq_hz`` = Re √λ / 2π (0 and damping ratio −1 for a
+        root λ < 0: divergence); ``mac_step``: MAC (subspace MAC in clusters) of each
+        branch with itself at the previous angle (label tracking: the MAC of the same
+        label's vectors if the method has vectors, else 1); NaN where a label-tracked
+        branch is absent at an angle.
+    """
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    if phi.ndim != 1 or phi.size == 0:
+        raise ValueError(f"phi must be a non-empty 1-D array of angles, got shape {phi.shape}")
+    if int(n_modes) != n_modes or not 1 <= n_modes <= chain.n:
+        raise ValueError(f"n_modes must be an integer in 1..{chain.n}, got {n_modes!r}")
+    n_modes = int(n_modes)
+    if method in ("transfer", "assembled"):
+        return _mac_sweep(chain, phi, n_modes, method, frequency_weight, keep_vectors)
+    if method in ("cyclic", "continuum"):
+        return _label_sweep(chain, phi, n_modes, method, keep_vectors)
+    raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
+
+
+def compare_methods(chain, phi, n_modes: int,
+                    methods=("assembled", "transfer", "continuum"), **options) -> dict:
+    """:func:`chain_sweep` by several methods on the same angles: ``{method: Sweep}``.
+
+    ``options`` go to every :func:`chain_sweep` (``frequency_weight``, ``keep_vectors``).
+    """
+    return {m: chain_sweep(chain, phi, n_modes, m, **options) for m in methods}
+
+
+def _modes(chain, phi, count, method, vectors=True) -> ChainModes:
+    """The ``count`` lowest roots at one angle by ``method``."""
+    if method == "transfer":
+        return transfer_modes(chain, phi, n_modes=count, vectors=vectors)
+    if method == "assembled":
+        return assembled_modes(chain, phi, n_modes=count)
+    if method == "cyclic":
+        from femmech.chain.cyclic import cyclic_modes
+
+        return cyclic_modes(chain, phi, vectors=vectors)
+    from femmech.chain.continuum import continuum_modes
+
+    return continuum_modes(chain, phi, count, vectors=vectors)
+
+
+def _lambda_columns(freq_hz):
+    """(λ, frequency Re √λ / 2π, damping ratio) from signed frequencies (ChainModes)."""
+    f = np.asarray(freq_hz, dtype=float)
+    lam = np.sign(f) * (2 * np.pi * f) ** 2
+    return lam.astype(complex), np.maximum(f, 0.0), np.where(f < 0, -1.0, 0.0)
+
+
+def _mac_sweep(chain, phi, n_modes, method, weight, keep_vectors) -> Sweep:
+    n_angles, n = phi.size, chain.n
+    lam = np.zeros((n_angles, n_modes), dtype=complex)
+    freq, ratio = np.zeros((n_angles, n_modes)), np.zeros((n_angles, n_modes))
+    mac_step = np.ones((n_angles, n_modes))
+    vectors = np.zeros((n_angles, n, n_modes)) if keep_vectors else None
+    extra = min(n_modes + max(2, n_modes // 2), n)
+    previous = None
+    for a, angle in enumerate(phi):
+        modes = _modes(chain, angle, extra, method)
+        f = modes.freq_hz
+        groups = clusters(f)
+        while f.size == extra < n and cuts_cluster(groups, f.size, n_modes):
+            extra = min(2 * extra, n)  # complete the cluster (kept for later angles)
+            modes = _modes(chain, angle, extra, method)
+            f = modes.freq_hz
+            groups = clusters(f)
+        M = chain.sparse_matrices(angle)[0]
+        V = _canonical_repeated(modes.vectors, f, M)  # solver-independent before assigning
+        if previous is None:
+            pick, macs = np.arange(n_modes), np.ones(n_modes)
+        else:
+            pick, macs = assign_branches(previous, V, f, groups, M, weight)
+        if previous is not None:
+            V = _align_repeated(V, f, pick, previous[0], M)
+        lam[a], freq[a], ratio[a] = _lambda_columns(f[pick])
+        mac_step[a] = macs
+        previous = (V[:, pick], f[pick])
+        if keep_vectors:
+            vectors[a] = previous[0]
+    return Sweep(phi, freq, lam, ratio, vectors, mac_step, "symmetric")
+
+
+def _align_repeated(V, f, pick, V_prev, M) -> np.ndarray:
+    """Rotate the basis of every exactly repeated root (relative spread below
+    :data:`REPEATED_RTOL`; e.g. followers of units in a dwell) onto the previous vectors
+    of the branches assigned to it (orthogonal Procrustes in the M inner product), so a
+    branch keeps its shape through the degeneracy instead of an arbitrary basis vector;
+    distinct roots are left alone. Returns a copy of V (n, q)."""
+    V = V.copy()
+    for g in _exact_groups(f):
+        branches = np.flatnonzero(np.isin(pick, g))
+        if g.size < 2 or branches.size == 0:
+            continue
+        A = V[:, g].T @ (M @ V_prev[:, branches])  # (|g|, |branches|)
+        U, _, Wt = np.linalg.svd(A, full_matrices=False)
+        aligned = V[:, g] @ (U @ Wt)  # M-orthonormal, closest to the previous vectors
+        V[:, pick[branches]] = aligned
+    return V
+
+
+def _canonical_repeated(V, f, M) -> np.ndarray:
+    """A basis of every exactly repeated root independent of the solver: the k rows
+    where the basis is most independent (QR with column pivoting) are made diagonal,
+    then M-orthonormalised symmetrically (Löwdin, the closest orthonormal basis). For
+    decoupled followers this gives one follower per vector. Returns a copy of V."""
+    V = V.copy()
+    for g in _exact_groups(f):
+        if g.size < 2:
+            continue
+        rows = np.sort(sla.qr(V[:, g].T, pivoting=True, mode="r")[1][:g.size])
+        B = V[:, g] @ np.linalg.inv(V[rows][:, g])
+        w, U = np.linalg.eigh(B.T @ (M @ B))
+        V[:, g] = B @ (U / np.sqrt(w)) @ U.T
+    return V
+
+
+def _exact_groups(f):
+    f = np.asarray(f, dtype=float)
+    size = np.maximum(np.abs(f[1:]), 1e-300)
+    cuts = np.flatnonzero(np.abs(np.diff(f)) > REPEATED_RTOL * size) + 1
+    return np.split(np.arange(f.size), cuts)
+
+
+def _label_sweep(chain, phi, n_modes, method, keep_vectors) -> Sweep:
+    n_angles, n = phi.size, chain.n
+    lam = np.full((n_angles, n_modes), np.nan, dtype=complex)
+    freq = np.full((n_angles, n_modes), np.nan)
+    ratio = np.zeros((n_angles, n_modes))
+    mac_step = np.ones((n_angles, n_modes))
+    vectors = np.full((n_angles, n, n_modes), np.nan) if keep_vectors else None
+    count = min(n, 2 * n_modes + 2 * chain.m)
+    keys, previous = None, None
+    for a, angle in enumerate(phi):
+        modes = _modes(chain, angle, count, method, vectors=True)
+        found = _keys(modes.label)
+        if keys is None:
+            keys = found[:n_modes]
+        where = {key: i for i, key in enumerate(found)}
+        idx = np.array([where.get(key, -1) for key in keys])
+        ok = idx >= 0
+        lam[a, ok], freq[a, ok], ratio[a, ok] = _lambda_columns(modes.freq_hz[idx[ok]])
+        V = None if modes.vectors is None else np.full((n, n_modes), np.nan)
+        if V is not None:
+            V[:, ok] = modes.vectors[:, idx[ok]]
+            if previous is not None:
+                mac_step[a] = _same_mac(previous, V, chain.sparse_matrices(angle)[0])
+            previous = V
+            if keep_vectors:
+                vectors[a] = V
+    return Sweep(phi, freq, lam, ratio, vectors, mac_step, "symmetric")
+
+
+def _keys(label) -> list[tuple[int, int]]:
+    """(label, rank within the label) of each root (roots ascending)."""
+    if label is None:
+        raise ValueError("label tracking needs ChainModes.label (cyclic, continuum)")
+    seen: dict[int, int] = {}
+    out = []
+    for j in np.asarray(label).tolist():
+        out.append((j, seen.get(j, 0)))
+        seen[j] = seen.get(j, 0) + 1
+    return out
+
+
+def _same_mac(X, Y, M) -> np.ndarray:
+    """Column-wise MAC of X and Y (n, k) with weight M; NaN where a column is NaN."""
+    MX, MY = M @ np.nan_to_num(X), M @ np.nan_to_num(Y)
+    num = np.einsum("ij,ij->j", X, MY) ** 2
+    return num / (np.einsum("ij,ij->j", X, MX) * np.einsum("ij,ij->j", Y, MY))
