@@ -119,3 +119,15 @@ def test_textile_shaft_reduced_matches_full(tmp_path):
     assert (tmp_path / "mac_reduced_vs_full.png").stat().st_size > 5_000
     assert (tmp_path / "coupled_mode_1.png").stat().st_size > 10_000
     assert (tmp_path / "quasi_frequencies.json").stat().st_size > 1_000
+
+
+@pytest.mark.slow
+def test_knitting_machine_chain_example(tmp_path):
+    # Issue 21 acceptance example (numbers checked in tests/test_scene_chain.py): it runs
+    # from the command line's main() and writes its three charts
+    result = _load("knitting_machine_chain").main(tmp_path, n_angles=13, starts=1)
+    assert result["max_rel_difference"]["transfer"] < 1e-9  # same problem, 1e-12 roots
+    assert result["margin_after"] > result["margin_before"]
+    assert [p.name for p in result["plots"]] == ["chain_sweep.png", "campbell.png",
+                                                 "synthesis_campbell.png"]
+    assert all(p.stat().st_size > 10_000 for p in result["plots"])

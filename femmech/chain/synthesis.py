@@ -53,6 +53,8 @@ from scipy.optimize import minimize
 from scipy.special import logsumexp
 from scipy.stats import qmc
 
+from femmech.solve import threads
+
 DEFAULT_ANGLES = 72
 """Drive angles sampled over one revolution (every 5°) when none are given."""
 
@@ -446,7 +448,8 @@ def _angles(phi, n_angles) -> np.ndarray:
 def frequency_bands(chain, phi=None, n_angles: int = DEFAULT_ANGLES) -> FrequencyBands:
     """All quasi-eigenfrequencies of the frozen chain over the revolution (Hz)."""
     phi = _angles(phi, n_angles)
-    lam, _ = frozen_eigen(*frozen_matrices(chain, phi), phi)
+    with threads.solve_phase():
+        lam, _ = frozen_eigen(*frozen_matrices(chain, phi), phi)
     return FrequencyBands(phi, _frequencies(lam))
 
 
@@ -563,8 +566,7 @@ class _Problem:
         Mm, Cm = self.matrices(down)
         h = up[j] - down[j]
         dM, dC = (Mp - Mm) / h, (Cp - Cm) / h
-        dlam = (np.einsum("ani,anm,ami->ai", V, dC, V)
-                - lam * np.einsum("ani,anm,ami->ai", V, dM, V))
+        dlam = np.sum(V * (dC @ V - lam[:, None, :] * (dM @ V)), axis=1)  # (angles, modes)
         return float(np.sum(g * dlam))
 
 
@@ -712,6 +714,15 @@ def synthesise(build, parameters, speed_rpm, harmonics: int, margin: float = 0.0
         Feasible designs are preferred, then the smallest change ("closest") or the
         largest margin; ``feasible`` False says that no start met the margin.
     """
+    with threads.solve_phase():  # many small dense solves: fastest on one BLAS thread
+        return _synthesise(build, parameters, speed_rpm, harmonics, margin, n_modes,
+                           n_angles, starts, seed, method, rho)
+
+
+def _synthesise(build, parameters, speed_rpm, harmonics: int, margin: float = 0.05,
+               n_modes: int | None = None, n_angles: int = DEFAULT_ANGLES, starts: int = 8,
+               seed=0, method: str = "closest", rho: float = KS_RHO) -> SynthesisResult:
+    """:func:`synthesise` inside the solve phase."""
     t0 = time.perf_counter()
     parameters = _check_parameters(parameters)
     if method not in ("closest", "max_margin"):

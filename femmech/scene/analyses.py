@@ -166,6 +166,9 @@ class Analyses:
     drive_event: DriveEventSpec | None = None
     speed_unit: str = "rpm"
     where: dict = field(default_factory=dict, compare=False)
+    chain_sweep: object = None  # femmech.scene.chain.ChainSweepSpec
+    campbell: object = None  # femmech.scene.chain.CampbellSpec
+    synthesis: object = None  # femmech.scene.chain.SynthesisSpec (table [synthesis])
 
 
 def _values(r: Reader, key: str, kind, default=None, maximum: int = MAX_POINTS,
@@ -192,6 +195,10 @@ def _values(r: Reader, key: str, kind, default=None, maximum: int = MAX_POINTS,
         return tuple(np.linspace(start, stop, n).tolist())
     raise r.error(key, f"expected a list of values or a table {{start, stop, n}}, got"
                        f" {show(value)}")
+
+
+read_values = _values
+"""Public name of :func:`_values` (for the chain tables, femmech.scene.chain)."""
 
 
 def _rayleigh(r: Reader) -> tuple:
@@ -224,22 +231,34 @@ _KEYS = {"modes": ("part", "n_modes", "band_hz", "model", "images", "vtu", "seri
 """Keys of each analysis table."""
 
 
-def read_analyses(r: Reader, parts: dict, mechanisms: dict, has_mounts: bool) -> Analyses:
-    """Parse ``[analyses]``; checks that each analysis has what it needs."""
-    r.expect("speed_unit", *_READERS)
+def read_analyses(r: Reader, parts: dict, mechanisms: dict, has_mounts: bool,
+                  extra: dict | None = None, synthesis=None) -> Analyses:
+    """Parse ``[analyses]``; checks that each analysis has what it needs.
+
+    ``extra``: {kind: reader(table) -> spec} of analyses read elsewhere (the chain's,
+    :mod:`femmech.scene.chain`); ``synthesis``: the spec of the top-level ``[synthesis]``.
+    """
+    extra = extra or {}
+    r.expect("speed_unit", *_READERS, *extra)
     unit = r.string("speed_unit", SPEED_UNITS[0], choices=SPEED_UNITS)
     out, where = {}, {}
-    readers = {k: r.table(k) for k in _READERS if r.has(k)}
+    if synthesis is not None:
+        out["synthesis"], where["synthesis"] = synthesis, "synthesis"
+    readers = {k: r.table(k) for k in (*_READERS, *extra) if r.has(k)}
     for kind, t in readers.items():
-        t.expect(*_KEYS[kind])
         where[kind] = t.where
+        if kind in extra:
+            out[kind] = extra[kind](t)
+            continue
+        t.expect(*_KEYS[kind])
         out[kind] = _READERS[kind](t, parts, mechanisms, has_mounts)
         if kind in ("sweep", "stability", "response"):
             out[kind] = replace(out[kind], speed_unit=unit)
     if not out:
         raise r.error(None, "no analyses requested: add [analyses.modes], [analyses.sweep],"
                             " [analyses.stability], [analyses.response], [analyses.check]"
-                            " or [analyses.drive_event]")
+                            " or [analyses.drive_event] (a chain: [analyses.chain_sweep],"
+                            " [analyses.campbell] or [synthesis])")
     if "sweep" in out:
         _distinct_labels(readers["sweep"], out["sweep"].speeds, unit)
     return Analyses(**out, speed_unit=unit, where=where)

@@ -48,6 +48,8 @@ from femmech.fe.model import (
 from femmech.fe.sections import BeamSection
 from femmech.reduction.component_modes import CUTOFF_FACTOR, craig_bampton, guyan
 from femmech.reduction.superelement import FORMAT_VERSION
+from femmech.scene.auto_mesh import auto_mesh, generate
+from femmech.scene.chain import check_chain
 from femmech.scene.load import PartSpec, Scene, fail
 from femmech.scene.mechanisms import check_drive_event, confined_module, mechanism_model
 from femmech.version import __version__
@@ -75,6 +77,8 @@ class Prepared:
     unexecuted : tuple of str
         Mechanisms from user modules that were not built (``prepare(run_code=False)``);
         absent from ``mechanisms``.
+    chain : femmech.chain.Chain or None
+        The scene's ``[chain]``, built (cheap: no solve).
     """
 
     scene: Scene
@@ -83,6 +87,7 @@ class Prepared:
     keys: dict
     findings: dict = field(default_factory=dict)
     unexecuted: tuple = ()
+    chain: object = None
 
 
 def prepare(scene: Scene, allow_code: bool = False, code_root=None,
@@ -128,7 +133,8 @@ def prepare(scene: Scene, allow_code: bool = False, code_root=None,
     findings = {name: part_findings(scene, part, meshes[name])
                 for name, part in scene.parts.items()}
     unexecuted = tuple(name for name in scene.mechanisms if name not in models)
-    return Prepared(scene, meshes, models, keys, findings, unexecuted)
+    chain = check_chain(scene.chain, scene.file) if scene.chain is not None else None
+    return Prepared(scene, meshes, models, keys, findings, unexecuted, chain)
 
 
 def finding_lines(prepared: Prepared) -> list[str]:
@@ -143,6 +149,16 @@ def part_mesh(scene: Scene, part: PartSpec) -> Mesh:
     try:
         if spec.file is not None:
             mesh = read_mesh(spec.file)
+        elif spec.auto:  # mesh = "auto": counts sized for the part's band
+            for where, key, ref in _node_refs(scene, part):
+                if not isinstance(ref, str):  # indices depend on the sized counts
+                    raise fail(scene, part.where, "mesh", f"with mesh = 'auto' give nodes by"
+                               f" group name, not {ref!r} ([{where}] {key})")
+            args = _model_args(scene, part)
+            mesh = auto_mesh(spec, args["beams"], args["shells"] or {},
+                             lambda m: part_model(scene, part, m))
+        elif spec.generator in ("rectangular_plate", "box"):
+            mesh = generate(spec.generator, spec.params)
         elif spec.generator == "grid_frame":
             mesh = grid_frame(**spec.params)
         else:

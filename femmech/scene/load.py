@@ -24,7 +24,8 @@ from pathlib import Path
 
 from femmech.errors import SceneError
 from femmech.scene.analyses import MAX_MODES, Analyses, read_analyses
-from femmech.scene.mesh import MeshSpec, read_mesh_spec
+from femmech.scene.chain import chain_analyses, read_chain, read_synthesis
+from femmech.scene.mesh import MeshSpec, read_mesh_spec, resolve_auto_band
 from femmech.scene.reader import MAX_SCENE_BYTES, Reader, check_limits, one_line, show
 from femmech.scene.units import (
     AREA,
@@ -58,7 +59,7 @@ _DIMENSION_KEYS = tuple(dict.fromkeys(
     key for dims in (*SECTION_SHAPES.values(), GENERAL_OPTIONAL) for key, _ in dims))
 _PART_KEYS = ("mesh", "generator", "edge_node_groups", "merge_nodes", "sections", "shells",
               "solids", "supports", "masses", "springs", "rigid_links", "interpolating_links",
-              "reduction")
+              "reduction", "target_error", "f_max_hz")
 @dataclass(frozen=True)
 class MaterialSpec:
     """Isotropic material: E (Pa), rho (kg/m³), nu or G (Pa)."""
@@ -170,6 +171,8 @@ class Scene:
     mechanisms : dict[str, femmech.scene.machine.MechanismSpec]
     mounts : tuple of femmech.scene.machine.MountSpec
     analyses : Analyses
+    chain : femmech.scene.chain.ChainSpec or None
+        The table ``[chain]``: a main shaft with N identical mechanisms.
     """
 
     name: str
@@ -181,6 +184,7 @@ class Scene:
     mechanisms: dict
     mounts: tuple
     analyses: Analyses
+    chain: object = None  # femmech.scene.chain.ChainSpec of the table [chain]
 
     @classmethod
     def from_dict(cls, data: dict, base_dir=".", file: str = "<dict>") -> Scene:
@@ -190,7 +194,8 @@ class Scene:
 
         check_limits(data, file)
         root = Reader(data, "", file)
-        root.expect("scene", "materials", "parts", "mechanisms", "mounts", "analyses")
+        root.expect("scene", "materials", "parts", "mechanisms", "mounts", "analyses",
+                    "chain", "synthesis")
         base = Path(base_dir).resolve()
         head = root.table("scene", {})
         head.expect("name", "description")
@@ -200,11 +205,16 @@ class Scene:
         parts = {n: _part(n, r, base, materials) for n, r in root.named_tables("parts").items()}
         mechanisms = read_mechanisms(root, base)
         mounts = read_mounts(root, parts, mechanisms)
-        analyses = read_analyses(root.table("analyses", {}), parts, mechanisms, bool(mounts))
-        if not parts and not mechanisms:
-            raise root.error(None, "the scene has neither [parts] nor [mechanisms]")
+        chain = read_chain(root.table("chain")) if root.has("chain") else None
+        synthesis = read_synthesis(root.table("synthesis"), chain) if root.has(
+            "synthesis") else None
+        analyses = read_analyses(root.table("analyses", {}), parts, mechanisms, bool(mounts),
+                                 chain_analyses(chain), synthesis)
+        parts = resolve_auto_band(parts, analyses, file)  # mesh = "auto": its band
+        if not parts and not mechanisms and chain is None:
+            raise root.error(None, "the scene has neither [parts], [mechanisms] nor [chain]")
         return cls(name, description, file, base, materials, parts, mechanisms, mounts,
-                   analyses)
+                   analyses, chain)
 
 
 def load_scene(path) -> Scene:

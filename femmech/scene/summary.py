@@ -45,6 +45,7 @@ from femmech.output.report import Section, Table
 from femmech.reduction.component_modes import CUTOFF_FACTOR
 from femmech.scene import units
 from femmech.scene.cache_folder import default_cache_dir
+from femmech.scene.chain import chain_table
 from femmech.scene.load import SECTION_SHAPES
 from femmech.scene.machine import parameter_kinds
 from femmech.scene.mechanisms import coordinate_names
@@ -129,6 +130,8 @@ def summary_section(ws) -> Section:
         tables.append(_mechanisms_table(ws))
     if scene.mounts:
         tables.append(_mounts_table(ws))
+    if scene.chain is not None:
+        tables.append(chain_table(scene.chain, ws.prepared.chain))
     machine = ws.machines.get(False)
     if machine is not None:
         text.append(f"Coupled machine: {machine.n} coordinates ({machine.n_frame} frame,"

@@ -14,6 +14,7 @@ from __future__ import annotations
 import csv
 import io
 import math
+import time
 import warnings
 from dataclasses import dataclass
 
@@ -32,12 +33,21 @@ from femmech.analysis.response import (
 from femmech.analysis.stability import stability_chart
 from femmech.analysis.studies import merge_charts
 from femmech.analysis.sweep import sweep
+from femmech.chain.sweep import chain_sweep
+from femmech.chain.synthesis import (
+    FrequencyBands,
+    Parameter,
+    frequency_bands,
+    margin_of,
+    synthesise,
+)
 from femmech.coupling import couple
 from femmech.errors import ConvergenceWarning
 from femmech.fe.model import node_index
 from femmech.mechanisms import Spring, quasi_modes
 from femmech.output import export_modes_vtu, frequency_table, plot_mac, write_frequency_csv
 from femmech.output.animate import animate_mode
+from femmech.output.campbell import plot_campbell, plot_margins, plot_synthesis
 from femmech.output.charts import format_speed, needs_log_scale, set_angle_axis, speed_scale
 from femmech.output.export import atomic_path
 from femmech.output.formatting import Quantity, format_value
@@ -48,6 +58,14 @@ from femmech.output.stability_charts import plot_stability_chart
 from femmech.output.sweeps import plot_quasi_frequencies
 from femmech.scene.analyses import MAX_DRIVE_EVALUATIONS
 from femmech.scene.build import machine_mounts
+from femmech.scene.chain import (
+    DESIGN,
+    METHOD_NAMES,
+    build_chain,
+    design_quantity,
+    design_values,
+    plot_method_sweeps,
+)
 from femmech.scene.machine import describe_quantity, parameter_kinds
 from femmech.scene.summary import participation_tables
 from femmech.scene.units import ANGLE, FORCE, LENGTH, MOMENT, ROT_STIFFNESS, STIFFNESS
@@ -630,5 +648,179 @@ def _drive_event_numbers(result, values, outputs) -> dict:
                          "force_change": num(acc.force_change)}}
 
 
+
+
+def _chain_rows(sweeps: dict, reference: str):
+    """Per method and branch: min, max over φ (Hz) and the largest relative difference
+    from the ``reference`` method (frequencies sorted per angle before comparing)."""
+    ref = np.sort(sweeps[reference].freq_hz, axis=1)
+    rows, diffs = [], {}
+    for method, s in sweeps.items():
+        f = np.sort(s.freq_hz, axis=1)
+        k = min(f.shape[1], ref.shape[1])
+        d = np.abs(f[:, :k] - ref[:, :k]) / np.where(ref[:, :k] > 0, ref[:, :k], 1.0)
+        diffs[method] = float(d.max()) if d.size else 0.0
+        rows += [(method, j + 1, float(f[:, j].min()), float(f[:, j].max()),
+                  f"{d[:, j].max():.1e}" if j < k else "-") for j in range(f.shape[1])]
+    return tuple(rows), diffs
+
+
+def run_chain_sweep(ws, spec, out):
+    """Quasi-eigenfrequencies of the chain over the drive angle by each method, side by
+    side: CSV, a chart with one panel per method, the differences between methods."""
+    chain, phi = ws.prepared.chain, np.asarray(spec.angles, dtype=float)
+    sweeps, seconds = {}, {}
+    for method in spec.methods:
+        with ws.timed(f"chain sweep {method}"):
+            start = time.perf_counter()
+            sweeps[method] = chain_sweep(chain, phi, spec.n_modes, method=method)
+            seconds[method] = time.perf_counter() - start
+    reference = "assembled" if "assembled" in sweeps else spec.methods[0]
+    rows, diffs = _chain_rows(sweeps, reference)
+    plot_method_sweeps(sweeps, out / "chain_sweep.png", f"{ws.scene.name}: {chain.n_units}"
+                       f" units, quasi-eigenfrequencies by method")
+    n = spec.n_modes
+    _write_csv(out / "chain_frequencies.csv", ["method", "angle_deg"] +
+               [f"f{k + 1}_hz" for k in range(n)],
+               [(m, float(np.rad2deg(a)), *s.freq_hz[i]) for m, s in sweeps.items()
+                for i, a in enumerate(s.phi)])
+    text = (f"Chain of {chain.n_units} units ({chain.n} coordinates), {phi.size} drive angles"
+            f" from {np.rad2deg(phi[0]):.1f}° to {np.rad2deg(phi[-1]):.1f}°, the {n} lowest"
+            " quasi-eigenfrequencies of the frozen chain (C(φ) v = ω² M(φ) v, Ω = 0) by "
+            + "; ".join(f"{m}: {METHOD_NAMES[m]}, {1e3 * seconds[m] / phi.size:.2f} ms per"
+                        f" angle" for m in sweeps) + ".",
+            f"The column 'vs {reference}' is the largest relative difference from the"
+            f" {reference} frequencies over all angles (sorted per angle). Round-off level"
+            " (1e-9 and below) means the methods agree; the continuum's difference is its"
+            " modelling error (smeared units), largest for the higher branches.")
+    table = Table("Range of each branch over the revolution, by method",
+                  ("method", "branch", "min (Hz)", "max (Hz)", f"vs {reference}"), rows)
+    section = Section("Chain: quasi-eigenfrequencies over the drive angle by method", text,
+                      (table,), (Figure("chain_sweep.png", "Quasi-eigenfrequencies of the"
+                                        " chain over one revolution; one panel per method,"
+                                        " common frequency axis"),),
+                      ("chain_frequencies.csv",))
+    return section, {"phi_rad": _list(phi), "reference": reference,
+                     "freq_hz": {m: _list(s.freq_hz) for m, s in sweeps.items()},
+                     "max_rel_difference": diffs}
+
+
+def _rpm(speeds) -> tuple:
+    """A speed range (rad/s) in rpm."""
+    return tuple(float(W) * 60 / (2 * np.pi) for W in speeds)
+
+
+def _margin_text(m, required: float) -> str:
+    """One sentence on a resonance margin (:class:`femmech.chain.synthesis.Margin`)."""
+    verdict = "meets" if m.value >= required else "does NOT meet"
+    return (f"resonance margin {100 * m.value:+.2f} % ({verdict} the required"
+            f" {100 * required:g} %): closest is branch f{m.branch + 1} = {m.frequency_hz:.2f}"
+            f" Hz at φ = {np.rad2deg(m.angle):.0f}°, {m.side} the band of harmonic"
+            f" k = {m.harmonic} ({m.band_hz[0]:.2f}–{m.band_hz[1]:.2f} Hz)")
+
+
+def run_campbell(ws, spec, out):
+    """Campbell diagram of the chain: the bands of its quasi-eigenfrequencies over one
+    revolution against the harmonic fan k·n over the speed range."""
+    rpm, chain = _rpm(spec.speeds), ws.prepared.chain
+    with ws.timed("campbell"):
+        bands = frequency_bands(chain, np.asarray(spec.angles, dtype=float))
+        shown = FrequencyBands(bands.phi, bands.freq_hz[:, :spec.n_modes])
+        m = margin_of(bands, rpm, spec.harmonics, spec.n_modes)
+    plot_campbell(shown, rpm, spec.harmonics, out / "campbell.png", margin=spec.margin)
+    _write_csv(out / "campbell_bands.csv", ["branch", "min_hz", "mean_hz", "max_hz",
+                                            "margin"],
+               [(k + 1, shown.low[k], shown.mean[k], shown.high[k], m.per_branch[k])
+                for k in range(shown.freq_hz.shape[1])])
+    text = (f"Speed range {rpm[0]:.0f}–{rpm[1]:.0f} rpm, harmonics k = 1…{spec.harmonics}:"
+            f" band k covers k·n/60 Hz over the range. The {shown.freq_hz.shape[1]} lowest"
+            f" quasi-eigenfrequencies of the frozen chain at {bands.phi.size} drive angles;"
+            " each branch is drawn as its min–max band over one revolution. Margin of a"
+            " frequency f to band k: max(1 − f/(k n_lo/60), f/(k n_hi/60) − 1), negative"
+            " inside the band.", "The r" + _margin_text(m, spec.margin)[1:] + ".")
+    rows = tuple((k + 1, float(shown.low[k]), float(shown.high[k]),
+                  f"{100 * m.per_branch[k]:+.2f} %" if m.per_branch[k] >= spec.margin else
+                  Flagged(f"{100 * m.per_branch[k]:+.2f} %"))
+                 for k in range(shown.freq_hz.shape[1]))
+    table = Table("Branches over one revolution and their margin to the harmonic bands",
+                  ("branch", "min (Hz)", "max (Hz)", "margin"), rows)
+    section = Section("Chain: Campbell diagram", text, (table,),
+                      (Figure("campbell.png", "Campbell diagram: quasi-eigenfrequency bands"
+                              " (min–max over one revolution) and the harmonic fan k·n;"
+                              " red marks: resonances inside the speed range"),),
+                      ("campbell_bands.csv",),
+                      warnings=() if m.value >= spec.margin else
+                      (f"The design resonates: {_margin_text(m, spec.margin)}.",))
+    return section, {"speed_rpm": list(rpm), "harmonics": spec.harmonics,
+                     "margin": m.value, "required": spec.margin,
+                     "low_hz": _list(shown.low), "high_hz": _list(shown.high)}
+
+
+_LOG_SCALE = ("coupling_stiffness", "flywheel_inertia", "follower_stiffness", "hub_inertia",
+              "station_inertia")
+"""Design parameters searched on a log scale (they may span decades)."""
+
+
+def run_synthesis(ws, spec, out):
+    """Synthesis: design parameters within bounds that keep every quasi-eigenfrequency
+    the required margin away from the harmonic bands; before/after Campbell diagrams."""
+    chain_spec, rpm = ws.scene.chain, _rpm(spec.speeds)
+    current = design_values(chain_spec)
+    params = [Parameter(name, lo, hi, current[name], log=name in _LOG_SCALE and lo > 0)
+              for name, lo, hi in spec.parameters]
+    with ws.timed("synthesis"):
+        r = synthesise(lambda values: build_chain(chain_spec, values), params, rpm,
+                       spec.harmonics, spec.margin, spec.n_modes, spec.n_angles,
+                       spec.starts, spec.seed, spec.objective)
+    plot_synthesis(r, out / "synthesis_campbell.png")
+    plot_margins(r, out / "synthesis_margins.png")
+    _write_csv(out / "synthesis.csv", ["parameter", "before_si", "after_si", "lower_si",
+                                       "upper_si"],
+               [(p.name, r.before[p.name], r.after[p.name], p.lower, p.upper)
+                for p in params])
+    rows = tuple((name, DESIGN[name][1], design_quantity(name, r.before[name]),
+                  design_quantity(name, r.after[name], 5),
+                  f"{design_quantity(name, lo)} … {design_quantity(name, hi)}")
+                 for name, lo, hi in spec.parameters)
+    rows += (("resonance margin", "smallest relative distance to a harmonic band",
+              f"{100 * r.margin_before.value:+.2f} %", f"{100 * r.margin_after.value:+.2f} %",
+              f"required ≥ {100 * spec.margin:g} %"),)
+    bad = r.not_converged
+    text = (f"Speed range {rpm[0]:.0f}–{rpm[1]:.0f} rpm, harmonics k = 1…{spec.harmonics},"
+            f" required margin {100 * spec.margin:g} %, {spec.n_angles} drive angles per"
+            f" revolution, {'all' if spec.n_modes is None else spec.n_modes} branches."
+            f" Objective {spec.objective!r}: " + (
+                "the feasible design closest to the scene's (normalised parameters)"
+                if spec.objective == "closest" else "the largest margin within the bounds")
+            + f"; {len(r.starts)} starts (the scene's design and a Latin hypercube), gradients"
+            " from the eigenvalue sensitivities (KS-smoothed minimum over angles, branches"
+            f" and harmonics); {r.evaluations} designs evaluated in {r.seconds:.1f} s.",
+            "Before: " + _margin_text(r.margin_before, spec.margin) + ".",
+            "After: " + _margin_text(r.margin_after, spec.margin) + f"; on a 4× finer angle"
+            f" grid {100 * r.margin_check.value:+.2f} %.")
+    warn = () if r.feasible else ("No start met the required margin within the bounds: the"
+                                  " design with the largest margin is shown. Widen the"
+                                  " bounds or narrow the speed range.",)
+    if bad:
+        text += (f"{len(bad)} of {len(r.starts)} starts ended without the optimiser's"
+                 " convergence flag (their designs are still evaluated exactly).",)
+    section = Section("Chain: synthesis", text, (Table(
+        "Design parameters before and after the synthesis", ("parameter", "meaning",
+                                                              "before", "after", "bounds"),
+        rows),), (Figure("synthesis_campbell.png", "Campbell diagram before (grey) and after"
+                         " (colour) the synthesis; hatched: harmonic bands widened by the"
+                         " margin"),
+                  Figure("synthesis_margins.png", "Smallest margin of each branch to the"
+                         " harmonic bands, before and after")), ("synthesis.csv",),
+        warnings=warn)
+    return section, {"feasible": bool(r.feasible), "margin_before": r.margin_before.value,
+                     "margin_after": r.margin_after.value,
+                     "margin_after_fine": r.margin_check.value, "required": spec.margin,
+                     "before": dict(r.before), "after": dict(r.after),
+                     "evaluations": r.evaluations}
+
+
 TASKS = {"modes": run_modes, "sweep": run_sweep, "stability": run_stability,
-         "response": run_response, "check": run_check, "drive_event": run_drive_event}
+         "response": run_response, "check": run_check, "drive_event": run_drive_event,
+         "chain_sweep": run_chain_sweep, "campbell": run_campbell,
+         "synthesis": run_synthesis}
