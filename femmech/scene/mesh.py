@@ -1,4 +1,7 @@
-"""Scene keys of a part's mesh: a mesh file or a generator (``grid_frame``, ``members``).
+"""Scene keys of a part's mesh: a mesh file or a generator (``grid_frame``, ``members``,
+``rectangular_plate``, ``box``), or ``mesh = "auto"``: a generator whose divisions are
+sized for the band of the scene's analyses (:mod:`femmech.fe.sizing`, built by
+:mod:`femmech.scene.auto_mesh`).
 
 The sizes a generator would produce are computed from the scene's numbers and checked
 against :data:`femmech.fe.mesh.MAX_NODES` and ``MAX_CELLS`` before anything is allocated;
@@ -11,23 +14,33 @@ mesh checks); nothing is built here.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from femmech.errors import SceneError
 from femmech.fe.checks import NEAR_NODE_TOL
 from femmech.fe.generators import MAX_ELEMENTS_PER_MEMBER, grid_frame_size
 from femmech.fe.mesh import MAX_CELLS, MAX_NODES
 from femmech.scene.reader import Reader, one_line, show
-from femmech.scene.units import LENGTH
+from femmech.scene.units import FREQUENCY, LENGTH
 
-GENERATORS = ("grid_frame", "members")
+GENERATORS = ("grid_frame", "members", "rectangular_plate", "box")
 MAX_SUBDIVISIONS = 10_000
 """Most elements per member of the ``grid_frame`` generator (``subdivisions``)."""
 MAX_BAYS = 1000
 """Most bays along one axis of the ``grid_frame`` generator."""
 _GENERATOR_KEYS = {"grid_frame": ("kind", "bays", "size", "subdivisions"),
-                   "members": ("kind", "joints", "members", "node_sets")}
+                   "members": ("kind", "joints", "members", "node_sets"),
+                   "rectangular_plate": ("kind", "a", "b", "divisions", "element"),
+                   "box": ("kind", "length", "width", "height", "divisions", "end_plates",
+                           "element")}
+SHELL_GENERATOR_ELEMENTS = ("quad", "triangle")
+"""Cell kinds the shell generators make from a scene (the kinds with measured sizing
+constants, :data:`femmech.fe.sizing.SHELL_BENDING`)."""
+AUTO_TARGET_ERROR = 1e-3
+"""Default ``target_error`` of ``mesh = "auto"``."""
 
 
 @dataclass(frozen=True)
@@ -41,15 +54,29 @@ class MeshSpec:
     edge_node_groups: tuple = ()
     where: str = field(default="", compare=False)
     merge_tol: float | None = None
+    # mesh = "auto" (outside the dataclass comparison, so that the reduction cache keys of
+    # other parts stay as they were; femmech.scene.build.reduction_key_data adds them for
+    # auto parts): the target and the band to size for, ("f_max_hz", f) or ("n_modes", n),
+    # filled in from the part's f_max_hz or the analyses (resolve_auto_band)
+    auto: bool = field(default=False, compare=False)
+    target_error: float | None = field(default=None, compare=False)
+    band: tuple | None = field(default=None, compare=False)
 
 
 def read_mesh_spec(r: Reader, base: Path) -> MeshSpec:
     """The mesh of a part: a file (``mesh``) or a generator table, sizes checked."""
-    if r.has("mesh") == r.has("generator"):
+    auto = r.has("mesh") and r.get("mesh") == "auto"
+    if auto and not r.has("generator"):
+        raise r.error("mesh", "mesh = 'auto' sizes a generator: add [generator] (kind"
+                              " members, grid_frame, rectangular_plate or box)")
+    if not auto and r.has("mesh") == r.has("generator"):
         raise r.error(None, "give exactly one of mesh (a file) and generator (a table)")
+    for key in ("target_error", "f_max_hz"):
+        if r.has(key) and not auto:
+            raise r.error(key, "only with mesh = 'auto' (a generator sized for a band)")
     edges = r.strings("edge_node_groups", ())
     merge = r.number("merge_nodes", LENGTH, None, positive=True)
-    if r.has("mesh"):
+    if r.has("mesh") and not auto:
         file = base / r.string("mesh")
         try:
             found = file.is_file()
@@ -62,8 +89,77 @@ def read_mesh_spec(r: Reader, base: Path) -> MeshSpec:
     g.expect(*dict.fromkeys(k for keys in _GENERATOR_KEYS.values() for k in keys))
     kind = g.string("kind", choices=GENERATORS)
     g.expect(*_GENERATOR_KEYS[kind], context=f"for kind = {kind!r}")
-    params = _grid_frame(g) if kind == "grid_frame" else _members(g)
-    return MeshSpec(None, kind, params, edges, g.where, merge)
+    if auto:
+        _no_divisions(g, kind)
+    readers = {"grid_frame": _grid_frame, "members": _members, "rectangular_plate": _plate,
+               "box": _box}
+    params = _members(g, auto) if kind == "members" else readers[kind](g)
+    if not auto:
+        if params.get("divisions", ()) is None:
+            raise g.error("divisions", "missing (required) without mesh = 'auto'")
+        return MeshSpec(None, kind, params, edges, g.where, merge)
+    target = r.number("target_error", None, AUTO_TARGET_ERROR, positive=True)
+    if not 1e-6 <= target <= 0.1:
+        raise r.error("target_error", f"expected a relative frequency error in [1e-6, 0.1],"
+                                      f" got {target:g}")
+    f_max = r.number("f_max_hz", FREQUENCY, None, positive=True)
+    band = ("f_max_hz", f_max) if f_max is not None else None
+    return MeshSpec(None, kind, params, edges, g.where, merge, True, target, band)
+
+
+_DIVISION_KEYS = {"grid_frame": ("subdivisions",), "rectangular_plate": ("divisions",),
+                  "box": ("divisions",)}
+
+
+def _no_divisions(g: Reader, kind: str) -> None:
+    """With ``mesh = "auto"`` the element counts are computed: refuse given ones."""
+    tables = g.tables("members") if kind == "members" and g.has("members") else [g]
+    for t in tables:
+        for key in _DIVISION_KEYS.get(kind, ("element_size", "divisions")):
+            if t.has(key):
+                raise t.error(key, "mesh = 'auto' computes the element counts; leave this out")
+
+
+def _lengths(g: Reader, keys) -> dict:
+    return {k: g.number(k, LENGTH, positive=True) for k in keys}
+
+
+def _shell_divisions(g: Reader, n: int, names: str) -> tuple | None:
+    """``divisions`` = n element counts (``None`` when absent: mesh = "auto")."""
+    if not g.has("divisions"):
+        return None
+    value = g.get("divisions")
+    if not (isinstance(value, list) and len(value) == n and all(
+            isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= MAX_SUBDIVISIONS
+            for v in value)):
+        raise g.error("divisions", f"expected {n} integers {names} in 1..{MAX_SUBDIVISIONS}"
+                                   f" (limit MAX_SUBDIVISIONS), got {show(value)}")
+    return tuple(value)
+
+
+def _plate(g: Reader) -> dict:
+    """Parameters of :func:`femmech.fe.generators.rectangular_plate` (``divisions`` =
+    [nx, ny]; without it the part must have ``mesh = "auto"``)."""
+    params = _lengths(g, ("a", "b"))
+    params["kind"] = g.string("element", "quad", choices=SHELL_GENERATOR_ELEMENTS)
+    params["divisions"] = _shell_divisions(g, 2, "[nx, ny]")
+    if params["divisions"] is not None:
+        nx, ny = params["divisions"]
+        _check_counts(g, "divisions", (nx + 1) * (ny + 1), 2 * nx * ny)
+    return params
+
+
+def _box(g: Reader) -> dict:
+    """Parameters of :func:`femmech.fe.generators.box` (``divisions`` = [nx, ny, nz])."""
+    params = _lengths(g, ("length", "width", "height"))
+    params["kind"] = g.string("element", "quad", choices=SHELL_GENERATOR_ELEMENTS)
+    params["end_plates"] = g.boolean("end_plates", True)
+    params["divisions"] = _shell_divisions(g, 3, "[nx, ny, nz]")
+    if params["divisions"] is not None:
+        nx, ny, nz = params["divisions"]
+        _check_counts(g, "divisions", 2 * (nx + 1) * (ny + nz) + 2 * (ny + 1) * (nz + 1),
+                      4 * (nx * (ny + nz) + ny * nz))
+    return params
 
 
 def _grid_frame(g: Reader) -> dict:
@@ -93,7 +189,7 @@ def _check_counts(r: Reader, key: str, n_nodes: int, n_elements: int) -> None:
                            " (limit MAX_CELLS)")
 
 
-def _members(g: Reader) -> dict:
+def _members(g: Reader, auto: bool = False) -> dict:
     raw = g.get("joints")
     if not isinstance(raw, dict) or not raw:
         raise g.error("joints", f"expected a table {{name = [x, y, z]}}, got {show(raw)}")
@@ -116,8 +212,9 @@ def _members(g: Reader) -> dict:
         size = m.number("element_size", LENGTH, None, positive=True)
         divisions = m.integer("divisions", None, minimum=1, maximum=MAX_ELEMENTS_PER_MEMBER,
                               limit="MAX_ELEMENTS_PER_MEMBER")
-        if (size is None) == (divisions is None):
+        if (size is None) == (divisions is None) and not auto:
             raise m.error(None, "give exactly one of element_size and divisions")
+        divisions = 1 if auto else divisions  # auto: sized later; overlaps checked here
         members.append({"group": m.string("group"), "chain": chain, "element_size": size,
                         "divisions": divisions})
         for k in _member_divisions(m, i, frame, chain, size, divisions):
@@ -178,4 +275,37 @@ def _member_divisions(m: Reader, i: int, frame: _Frame, chain, size, divisions) 
                           f" {frame.shortest:.3g} m ({NEAR_NODE_TOL:g} of the frame's size,"
                           " the near-node distance of femmech.fe.checks)")
         out.append(k)
+    return out
+
+
+def resolve_auto_band(parts: dict, analyses, file: str) -> dict:
+    """The parts with the band of each ``mesh = "auto"`` filled in (:attr:`MeshSpec.band`).
+
+    In order: the part's ``f_max_hz``; the ``[analyses.modes]`` of the part (the top of
+    ``band_hz``, else its ``n_modes``: the frequency of the last mode, found on the
+    sized mesh itself); the part's reduction (``f_max_hz``, ``cutoff_hz``, else its
+    ``n_modes``). SceneError at the part's ``mesh`` when none gives a band. The band then
+    joins the reduction's cache key with the rest of the mesh spec.
+    """
+    modes = getattr(analyses, "modes", None)
+    out = {}
+    for name, part in parts.items():
+        spec = part.mesh
+        if not spec.auto or spec.band is not None:
+            out[name] = part
+            continue
+        band = None
+        if modes is not None and modes.part == name:
+            band = (("f_max_hz", modes.band_hz[1]) if modes.band_hz is not None
+                    else ("n_modes", modes.n_modes))
+        elif part.reduction is not None and part.reduction.method == "craig_bampton":
+            r = part.reduction
+            f = r.f_max_hz if r.f_max_hz is not None else r.cutoff_hz
+            band = ("f_max_hz", f) if f is not None else ("n_modes", r.n_modes)
+        if band is None or band[1] is None or band[1] == 0:
+            raise SceneError(one_line(
+                f"{file}: [{part.where}] mesh: mesh = 'auto' needs a band to size for: give"
+                " f_max_hz, an [analyses.modes] of this part (n_modes or band_hz) or a"
+                " craig_bampton reduction"))
+        out[name] = dataclasses.replace(part, mesh=dataclasses.replace(spec, band=band))
     return out
