@@ -100,7 +100,7 @@ def build(values: dict):
                  left=End.elastic(v["coupling_stiffness"]), right=End.free(), cells=True)
 
 
-def main(out_dir="out", n_angles: int = 73, starts: int = 3) -> dict:
+def main(out_dir="out", n_angles: int = 73, starts: int = 2) -> dict:
     """Sweep by three methods, Campbell diagram, synthesis; PNGs into ``out_dir``.
 
     Returns

@@ -7,6 +7,7 @@ Not a stage: it re-exports the public API of the stages (docs/architecture.md);
 nothing inside femmech imports it.
 """
 
+from femmech.analysis.discretisation import DiscretisationEstimate, discretisation_error
 from femmech.analysis.modes import ModeSet, modes
 from femmech.errors import (
     CacheWarning,
@@ -34,6 +35,7 @@ from femmech.fe.model import (
     SolidSet,
     build_model,
 )
+from femmech.fe.refine import refine_mesh
 from femmech.fe.sections import BeamSection
 from femmech.version import __version__
 
@@ -46,6 +48,7 @@ __all__ = [
     "CacheWarning",
     "FEModel",
     "ConvergenceWarning",
+    "DiscretisationEstimate",
     "FemmechWarning",
     "FileFormatError",
     "InputError",
@@ -66,6 +69,8 @@ __all__ = [
     "Support",
     "UserCodeError",
     "build_model",
+    "discretisation_error",
     "modes",
     "read_mesh",
+    "refine_mesh",
 ]

@@ -19,7 +19,10 @@ themselves must follow from the problem.
 * femmech's *solve* and *factor* phases use N threads (``femmech.solve.threads.set_threads``);
 * ``hard_cases/conftest.py`` limits its modules to N threads instead of 1.
 
-The header of the pytest run names the libraries and their thread counts. This file also
+The header of the pytest run names the libraries and their thread counts. Tests marked
+``heavy`` (minutes each: large meshes that confirm a light test's claim at a tighter
+target) run only with ``FEMMECH_HEAVY_TESTS=1``; otherwise they are reported as skipped
+with that reason, never silently dropped. This file also
 puts ``tests/`` on ``sys.path`` (pytest's ``prepend`` import mode), so that ``roundoff``
 imports from ``hard_cases/`` and ``mechanisms/`` too.
 """
@@ -75,3 +78,16 @@ def pytest_report_header(config):
     n = session_threads()
     asked = f"{ENV_VAR}={n}" if n is not None else f"{ENV_VAR} not set"
     return f"{asked}; {threads.describe()}"
+
+
+HEAVY_VAR = "FEMMECH_HEAVY_TESTS"
+
+
+def pytest_collection_modifyitems(config, items):
+    """Skip ``heavy`` tests unless ``FEMMECH_HEAVY_TESTS=1`` (module docstring)."""
+    if os.environ.get(HEAVY_VAR) == "1":
+        return
+    skip = pytest.mark.skip(reason=f"heavy (minutes): run with {HEAVY_VAR}=1")
+    for item in items:
+        if "heavy" in item.keywords:
+            item.add_marker(skip)

@@ -5,11 +5,13 @@ Stage 5 (analysis): uses reduction, fe and solve; nothing here writes files.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 
+from femmech.analysis.shell_checks import drilling_findings, drilling_fractions
 from femmech.fe import checks
 from femmech.fe.dofs import DOF_PER_NODE
 from femmech.fe.model import FEModel
@@ -52,6 +54,12 @@ class ModeSet:
         Sparse direct solver of the shift-invert factorisation (``"superlu"``,
         ``"cholmod"``, ``"pardiso"``; :mod:`femmech.solve.direct`), ``"pyamg"`` for LOBPCG,
         None for dense LAPACK.
+    drilling : ndarray (n_modes,) or None
+        For models with shell elements: the fraction of each mode's kinetic energy in
+        rotations about the shell normals
+        (:func:`femmech.analysis.shell_checks.drilling_fractions`); near 1 for the
+        spurious drilling modes of thick shells, near 0 for structural modes. None for
+        models without shells.
     """
 
     freq_hz: np.ndarray
@@ -64,6 +72,7 @@ class ModeSet:
     sturm_count: int | None
     error_estimate: np.ndarray | None = None
     solver: str | None = None
+    drilling: np.ndarray | None = None
 
     def __repr__(self) -> str:
         f = np.asarray(self.freq_hz)
@@ -110,7 +119,9 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
     ----------
     model : FEModel
     n_modes : int, optional
-        Number of lowest modes.
+        Number of lowest modes, rigid-body modes included: ``n_modes=12`` of a free-free
+        structure gives its 6 rigid-body modes (0 Hz, flagged in :attr:`ModeSet.rigid`)
+        and its 6 lowest elastic modes.
     band_hz : (float, float), optional
         All modes with ``f_lo <= f <= f_hi``, Hz (exactly one of n_modes and band_hz). A
         band from 0 holds all rigid-body modes (:data:`femmech.solve.eigen.RIGID_TOL`).
@@ -136,7 +147,8 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
     -----
     ModelWarning
         For a first elastic frequency that only a unit mix-up gives
-        (:func:`femmech.fe.checks.frequency_findings`).
+        (:func:`femmech.fe.checks.frequency_findings`), and for spurious drilling modes of
+        thick shells (:func:`femmech.analysis.shell_checks.drilling_findings`).
 
     Examples
     --------
@@ -165,10 +177,19 @@ def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, floa
                                      check=check, scale=scale)
     else:
         raise ValueError(f"method must be 'shift-invert' or 'lobpcg', got {method!r}")
-    out = _mode_set(result, model.expand(result.vectors), scale)
+    out = _with_drilling(_mode_set(result, model.expand(result.vectors), scale), model)
     lowest = band is None or band[0] <= RIGID_TOL * scale
     checks.warn(checks.frequency_findings(out.freq_hz, out.rigid, is_supported(model), lowest))
     return out
+
+
+def _with_drilling(out: ModeSet, model: FEModel | None) -> ModeSet:
+    """``out`` with :attr:`ModeSet.drilling` for a model with shells, warned about."""
+    if model is None or not any(len(c) for c in model.shells.cells.values()):
+        return out
+    share = drilling_fractions(model, out.shapes)
+    checks.warn(drilling_findings(share, out.freq_hz, out.rigid))
+    return dataclasses.replace(out, drilling=share)
 
 
 def is_supported(model: FEModel) -> bool:
@@ -230,11 +251,13 @@ def superelement_modes(se: Superelement, n_modes: int | None = None,
     ----------
     se : Superelement
     n_modes, band_hz
-        As in :func:`modes` (dense LAPACK on the reduced matrices).
+        As in :func:`modes` (dense LAPACK on the reduced matrices); ``n_modes`` counts
+        rigid-body modes too.
     model : FEModel, optional
         The model that was reduced; when given, each mode gets an a-posteriori estimate
         of its relative frequency error (:attr:`ModeSet.error_estimate`), computed from
-        the residual in the full model without a full eigen solve.
+        the residual in the full model without a full eigen solve, and for shell models
+        its drilling share (:attr:`ModeSet.drilling`).
 
     Returns
     -------
@@ -257,7 +280,7 @@ def superelement_modes(se: Superelement, n_modes: int | None = None,
     estimate = None
     if model is not None:
         estimate = frequency_error_estimates(model, se, result.omega2, result.vectors)
-    out = _mode_set(result, se.recover(result.vectors), lam_max, estimate)
+    out = _with_drilling(_mode_set(result, se.recover(result.vectors), lam_max, estimate), model)
     lowest = band_hz is None or band_hz[0] == 0
     checks.warn(checks.frequency_findings(out.freq_hz, out.rigid, False, lowest))
     return out

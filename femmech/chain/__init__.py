@@ -21,13 +21,13 @@ from femmech.chain.frame import guided_unit, mount_chain
 from femmech.chain.model import Chain, End, chain, follower_unit, torsion_segment
 from femmech.chain.results import ChainModes
 from femmech.chain.sweep import chain_sweep, compare_methods
-from femmech.chain.transfer import assembled_modes, count_below, transfer_modes
 from femmech.chain.synthesis import (
     Parameter,
     SynthesisResult,
     resonance_margin,
     synthesise,
 )
+from femmech.chain.transfer import assembled_modes, count_below, transfer_modes
 
 __all__ = ["guided_unit", "mount_chain", "Chain", "End", "chain", "follower_unit",
            "torsion_segment", "Parameter", "SynthesisResult", "resonance_margin", "synthesise",

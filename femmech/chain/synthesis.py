@@ -407,10 +407,17 @@ def frozen_eigen(M, C, phi=None) -> tuple[np.ndarray, np.ndarray]:
         ok = np.array([np.all(np.linalg.eigvalsh(m) > 0) for m in M])
         raise ValueError(f"M(φ) is not positive definite at {_where(phi, ~ok)} (a"
                          " coordinate without mass?)") from None
+    lam, W = np.linalg.eigh(_standard(M, C, L))
+    return lam, np.linalg.solve(np.swapaxes(L, 1, 2), W)
+
+
+def _standard(M, C, L=None) -> np.ndarray:
+    """``L⁻¹ C L⁻ᵀ`` (symmetrised) with ``M = L Lᵀ``: the standard form of ``C v = λ M v``,
+    batched (n_angles, n, n)."""
+    L = np.linalg.cholesky(M) if L is None else L
     X = np.linalg.solve(L, C)  # L⁻¹ C
     A = np.linalg.solve(L, np.swapaxes(X, 1, 2))  # L⁻¹ C L⁻ᵀ
-    lam, W = np.linalg.eigh(0.5 * (A + np.swapaxes(A, 1, 2)))
-    return lam, np.linalg.solve(np.swapaxes(L, 1, 2), W)
+    return 0.5 * (A + np.swapaxes(A, 1, 2))
 
 
 def _where(phi, mask) -> str:
@@ -556,6 +563,15 @@ class _Problem:
         self._memo = {key: (ks, grad, margin)}
         return ks, grad, margin
 
+    def margin(self, x) -> float:
+        """The true margin at x alone (one build and eigen solve, no gradient)."""
+        M, C = self.matrices(x)
+        self.counts["evaluations"] += 1
+        freq = _frequencies(np.linalg.eigvalsh(_standard(M, C)))
+        keep = _kept(freq, self.n_modes)
+        return float(np.where(keep[..., None], band_distance(freq, self.lo, self.hi),
+                              np.inf).min())
+
     def _directional(self, x, j, lam, V, g) -> float:
         """dKS/dx_j = Σ g vᵀ (dC - λ dM) v, matrices differenced in x_j (central inside
         [0, 1], one-sided at a bound: the parameter never leaves its bounds)."""
@@ -633,7 +649,8 @@ def _nearest(problem, x, x0, margin):
 
 
 def _starts(n_continuous: int, x0, starts: int, seed) -> np.ndarray:
-    """The initial design, then a Latin hypercube of starts - 1 points in [0, 1]^d."""
+    """The initial design, then a Latin hypercube of starts - 1 points in [0, 1]^d
+    (screened by :func:`_screened_starts`)."""
     if int(starts) != starts or starts < 1:
         raise ValueError(f"starts must be a positive integer, got {starts!r}")
     if starts == 1:
@@ -755,7 +772,25 @@ def _combination(problem, x0, margin, method, change, starts, seed) -> list:
         return [StartReport(values, values, true, float(change), true >= margin, True,
                             "fixed", "evaluated (no continuous parameter)", 0, 1)]
     return [_run_start(problem, x_start, x0, margin, method, change)
-            for x_start in _starts(len(x0), x0, starts, seed)]
+            for x_start in _screened_starts(problem, x0, starts, seed)]
+
+
+SCREEN_PER_START = 8
+"""Designs screened (margin only, no gradient) per Latin-hypercube start: the local runs
+start from the best of them, so a few starts find the feasible region of a multimodal
+margin (the knitting example: 2 starts, where 3 unscreened ones were needed)."""
+
+
+def _screened_starts(problem, x0, starts: int, seed) -> np.ndarray:
+    """The initial design, then the starts - 1 best (largest margin) of a Latin hypercube
+    of SCREEN_PER_START · (starts - 1) designs."""
+    candidates = _starts(len(x0), x0, SCREEN_PER_START * (int(starts) - 1) + 1, seed) \
+        if int(starts) == starts and starts > 1 else _starts(len(x0), x0, starts, seed)
+    if len(candidates) == 1:
+        return candidates
+    scores = np.array([problem.margin(x) for x in candidates[1:]])
+    best = np.argsort(-scores, kind="stable")[: int(starts) - 1]
+    return np.vstack([x0[None], candidates[1:][best]])
 
 
 def _best(reports, method, margin) -> StartReport:

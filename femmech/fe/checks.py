@@ -25,6 +25,13 @@ Units (:func:`unit_findings`, :func:`frequency_findings`)
     mass of the elements, and first natural frequencies outside
     [:data:`FREQ_BELOW_HZ`, :data:`FREQ_ABOVE_HZ`]. A consistent model in any unit
     system (m-kg-s, mm-t-s) passes.
+Element shapes (:func:`shell_shapes`, :func:`shape_findings`)
+    Shell elements whose shape costs accuracy: an edge aspect ratio above
+    :data:`ASPECT_ABOVE`, quads warped by more than :data:`WARP_ABOVE`, interior angles
+    outside :data:`QUAD_ANGLES` (quads) or :data:`TRIANGLE_ANGLES` (triangles), named by
+    element id (the index within its cell kind, as in the element errors of
+    :mod:`femmech.fe.elements.shell`) and group. Spurious drilling modes of thick shells
+    are a property of the modes, not the inputs: :mod:`femmech.analysis.shell_checks`.
 
 Stage 2 (fe, independent of mechanisms): uses only errors (ModelWarning).
 """
@@ -106,7 +113,8 @@ class Finding:
     Attributes
     ----------
     kind : str
-        ``"near nodes"``, ``"loose part"``, ``"units"`` or ``"frequency"``.
+        ``"near nodes"``, ``"loose part"``, ``"units"``, ``"frequency"``,
+        ``"element shape"`` or ``"drilling modes"``.
     message : str
         One line naming the nodes, groups and values concerned.
     nodes : ndarray (n,) of int
@@ -441,6 +449,161 @@ def frequency_findings(freq_hz: np.ndarray, rigid: np.ndarray, supported: bool,
                         f" model is {elastic[0]:.4g} Hz, below {FREQ_BELOW_HZ:g} Hz: units"
                         " (E in N/mm² with the rest in SI?) or a nearly free part?", none)]
     return []
+
+
+ASPECT_ABOVE = 10.0
+"""Edge aspect ratio (longest / shortest edge of the corner polygon, the definition of
+Abaqus/CAE's Verify Mesh and of HyperMesh and OptiStruct for shells) above which an element
+is reported. An element ten times longer than wide resolves the field along its long side
+with a tenth of the points it has across, so the error is set by the long side while the
+DOFs are spent on the short one; 10 is the usual limit of those tools' quality checks for
+stress and frequency analysis (Nastran's far laxer 100 only guards against singularity)."""
+
+WARP_ABOVE = 0.05
+"""Quad warping ``z₀ / (d̄ / 2)`` above which a quad is reported: ``z₀`` the distance of the
+corners from the element's mean plane (the ``±z₀`` of the warped-quad correction in
+:mod:`femmech.fe.elements.shell`), ``d̄`` the mean length of the two diagonals, so that
+``d̄ / 2`` is the distance of a square's corners from its centre. 0.05 is the default
+tolerance of MSC Nastran's quad warping test (GEOMCHECK ``Q4_WARP``); the flat
+element built on the mean plane is a fair stand-in only while the corners lie close to
+it."""
+
+QUAD_ANGLES = (15.0, 165.0)
+"""Interior angles of quads (degrees) outside this range are reported: the warning limits
+of OptiStruct's CQUAD4 vertex-angle check. The bilinear map of a quad with an angle near
+180° (or 0°) has a Jacobian near zero at that corner, and the element stiffens. Nastran's
+stricter GEOMCHECK angles (30°-150°) flag the moderately distorted quads of free meshes
+that still do well: a simply supported thin plate, 8 x 8 MITC4 quads with the interior
+nodes moved randomly by up to 30 % of the element size (largest angle 163.7°), errs
+2.3/7.3/8.7/9.9 % in its first four frequencies against 1.7/6.6/6.6/7.3 % on the regular
+mesh (tests/hard_cases/test_thin_shells.py)."""
+
+TRIANGLE_ANGLES = (10.0, 160.0)
+"""Interior angles of triangles (degrees) outside this range are reported (GEOMCHECK's
+triangle limits ``T3_SKEW`` 10°, ``T3_IAMAX`` 160°, applied to the corner angles): slivers
+whose smallest altitude is a small fraction of their longest edge."""
+
+
+def shell_shapes(points: np.ndarray, kind: str, cells: np.ndarray) -> dict:
+    """Shape measures of shell elements from their corner nodes, vectorised.
+
+    Parameters
+    ----------
+    points : ndarray (n_nodes, 3), m
+    kind : str
+        ``"triangle"``, ``"quad"`` or a quadratic variant (``"triangle6"``, ``"quad8"``,
+        ``"quad9"``: corner nodes only, listed first).
+    cells : ndarray (n_cells, nodes_per_cell)
+
+    Returns
+    -------
+    dict of ndarray (n_cells,)
+        ``"aspect"``: longest / shortest edge (``inf`` for a zero-length edge);
+        ``"warping"``: ``z₀ / (d̄ / 2)`` (:data:`WARP_ABOVE`; 0 for triangles);
+        ``"min_angle"``, ``"max_angle"``: smallest and largest interior angle, degrees.
+    """
+    k = CORNERS[kind]
+    x = np.asarray(points, dtype=float)[np.asarray(cells)[:, :k]]  # (n, k, 3)
+    edge = np.roll(x, -1, axis=1) - x  # edge i runs from corner i to corner i + 1
+    length = np.linalg.norm(edge, axis=2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        aspect = np.where(length.min(axis=1) > 0, length.max(axis=1)
+                          / np.where(length.min(axis=1) > 0, length.min(axis=1), 1.0), np.inf)
+        a, b = -np.roll(edge, 1, axis=1), edge  # the two edges leaving each corner
+        cos = np.sum(a * b, axis=2) / (np.linalg.norm(a, axis=2) * length)
+    angle = np.degrees(np.arccos(np.clip(np.nan_to_num(cos, nan=1.0), -1.0, 1.0)))
+    warping = np.zeros(len(x))
+    if k == 4:
+        d1, d2 = x[:, 2] - x[:, 0], x[:, 3] - x[:, 1]
+        normal = np.cross(d1, d2)
+        size = np.linalg.norm(normal, axis=1)
+        z0 = np.abs(np.sum(normal * (x[:, 0] - x.mean(axis=1)), axis=1))
+        half = 0.25 * (np.linalg.norm(d1, axis=1) + np.linalg.norm(d2, axis=1))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            warping = np.where(size * half > 0, z0 / np.where(size * half > 0, size * half,
+                                                              1.0), np.inf)
+    return {"aspect": aspect, "warping": warping, "min_angle": angle.min(axis=1),
+            "max_angle": angle.max(axis=1)}
+
+
+def cell_groups(cell_sets: dict, names, cells: dict) -> dict:
+    """Per cell kind of ``cells``, the group (of ``names``) of each cell, ``None`` where the
+    cell is in none of them: dict[str, ndarray (n_cells,) of object]."""
+    out = {kind: np.full(len(c), None, dtype=object) for kind, c in cells.items()}
+    for name in names:
+        for kind, idx in cell_sets.get(name, {}).items():
+            if kind in out:
+                out[kind][np.asarray(idx, dtype=np.int64)] = name
+    return out
+
+
+def shape_findings(points: np.ndarray, cells: dict, groups: dict) -> list[Finding]:
+    """Badly shaped shell elements, one finding per measure (:func:`shell_shapes`).
+
+    Parameters
+    ----------
+    points : ndarray (n_nodes, 3), m
+    cells : dict[str, ndarray (n_cells, nodes_per_cell)]
+        Shell cells by kind (other kinds are skipped).
+    groups : dict[str, ndarray (n_cells,) of object]
+        Group of each cell (:func:`cell_groups`); cells with ``None`` are not checked.
+
+    Returns
+    -------
+    list of Finding
+        Kind ``"element shape"``; the worst elements first, named ``quad 12 (group
+        'plate')`` with their value, and the nodes of every reported element.
+    """
+    bad = {"aspect": [], "warping": [], "angle": []}
+    for kind, c in cells.items():
+        c = np.asarray(c)
+        if not kind.startswith(("triangle", "quad")) or kind not in CORNERS or not len(c):
+            continue
+        group = groups.get(kind, np.full(len(c), None, dtype=object))
+        checked = np.array([g is not None for g in group], dtype=bool)
+        m = shell_shapes(points, kind, c)
+        lo, hi = TRIANGLE_ANGLES if kind.startswith("triangle") else QUAD_ANGLES
+        off = np.maximum(lo - m["min_angle"], m["max_angle"] - hi)  # degrees beyond a limit
+        angle = np.where(lo - m["min_angle"] >= m["max_angle"] - hi, m["min_angle"],
+                         m["max_angle"])
+        for key, value, worse, hit in (
+                ("aspect", m["aspect"], m["aspect"], m["aspect"] > ASPECT_ABOVE * _ROUND),
+                ("warping", m["warping"], m["warping"], m["warping"] > WARP_ABOVE * _ROUND),
+                ("angle", angle, off, off > 1e-9)):  # limits met exactly pass (round-off)
+            e = np.flatnonzero(hit & checked)
+            if e.size:
+                bad[key].append((worse[e], value[e], e, kind, group[e], c[e]))
+    return [_shape_finding(key, items) for key, items in bad.items() if items]
+
+
+_ROUND = 1.0 + 1e-9
+"""Elements exactly at a limit (a 10:1 grid) are not reported despite round-off."""
+
+_SHAPE_TEXT = {
+    "aspect": (f"an edge aspect ratio (longest / shortest edge) above {ASPECT_ABOVE:g}", "{:.3g}",
+               "; such elongated elements lose accuracy along their long side: remesh with"
+               " elements closer to square"),
+    "warping": (f"corners off their mean plane by more than {WARP_ABOVE:g} of half the mean"
+                " diagonal (warping)", "{:.3g}", "; the flat element on the mean plane then"
+                " misses the curvature: refine the curved region"),
+    "angle": (f"interior angles outside {QUAD_ANGLES[0]:g}-{QUAD_ANGLES[1]:g}° (quads) or"
+              f" {TRIANGLE_ANGLES[0]:g}-{TRIANGLE_ANGLES[1]:g}° (triangles)", "{:.1f}°",
+              "; distorted elements are too stiff: remesh")}
+
+
+def _shape_finding(key: str, items: list) -> Finding:
+    """One finding from the (worse, value, ids, kind, groups, cells) batches of a measure."""
+    worse = np.concatenate([i[0] for i in items])
+    value = np.concatenate([i[1] for i in items])
+    ids = np.concatenate([i[2] for i in items])
+    kind = np.concatenate([np.full(i[2].size, i[3], dtype=object) for i in items])
+    group = np.concatenate([i[4] for i in items])
+    order = np.argsort(-worse, kind="stable")[:MAX_LISTED]
+    head, fmt, advice = _SHAPE_TEXT[key]
+    named = [f"{kind[j]} {ids[j]} (group {group[j]!r}): {fmt.format(value[j])}" for j in order]
+    nodes = np.unique(np.concatenate([np.ravel(i[5]) for i in items]))
+    return Finding("element shape", f"{ids.size} shell element(s) with {head}:"
+                   f" {_listed(named, ids.size)}{advice}", nodes)
 
 
 def warn(findings) -> None:

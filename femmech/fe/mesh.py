@@ -318,3 +318,41 @@ def line_submesh(mesh: Mesh, elements) -> tuple[Mesh, np.ndarray]:
             node_sets[name] = sub[sub >= 0]
     sub = Mesh(mesh.points[node_ids], {"line": new_node[lines[keep]]}, cell_sets, node_sets)
     return sub, node_ids
+
+
+def quad8_to_quad9(mesh: Mesh) -> Mesh:
+    """Mesh with each 8-node quad turned into a 9-node one (MITC9 shells take quad9).
+
+    The centre node of each ``"quad8"`` cell is placed where the serendipity map puts
+    the element centre, ``x(0, 0) = ½ Σ edge nodes - ¼ Σ corners``, and appended after
+    the existing nodes, so that every node keeps its index and node sets stay valid.
+    The cells join the ``"quad9"`` cells (after any already there), and cell sets follow
+    them. A mesh without quad8 cells is returned unchanged.
+
+    Parameters
+    ----------
+    mesh : Mesh
+
+    Returns
+    -------
+    Mesh
+        ``mesh.n_nodes + n_quad8`` nodes; no ``"quad8"`` cells.
+    """
+    quad8 = mesh.cells.get("quad8")
+    if quad8 is None:
+        return mesh
+    X = mesh.points[quad8]
+    centre = 0.5 * X[:, 4:].sum(axis=1) - 0.25 * X[:, :4].sum(axis=1)
+    new = mesh.n_nodes + np.arange(len(quad8))
+    old9 = mesh.cells.get("quad9", np.empty((0, 9), dtype=np.int64))
+    cells = {k: v for k, v in mesh.cells.items() if k not in ("quad8", "quad9")}
+    cells["quad9"] = np.vstack([old9, np.column_stack([quad8, new])])
+    cell_sets = {}
+    for name, by_type in mesh.cell_sets.items():
+        sets = {k: v for k, v in by_type.items() if k not in ("quad8", "quad9")}
+        parts = [by_type.get("quad9", np.empty(0, dtype=np.int64)),
+                 len(old9) + by_type.get("quad8", np.empty(0, dtype=np.int64))]
+        if "quad8" in by_type or "quad9" in by_type:
+            sets["quad9"] = np.concatenate(parts)
+        cell_sets[name] = sets
+    return Mesh(np.vstack([mesh.points, centre]), cells, cell_sets, mesh.node_sets)

@@ -34,7 +34,7 @@ from femmech.fe.elements.beam import beam_matrices, local_frames
 from femmech.fe.elements.registry import kinds
 from femmech.fe.lumped import PointMass, Spring
 from femmech.fe.materials import Material
-from femmech.fe.mesh import Mesh
+from femmech.fe.mesh import Mesh, quad8_to_quad9
 from femmech.fe.parts import (
     ShellProperty,
     ShellSet,
@@ -148,6 +148,10 @@ class FEModel:
         Rotational DOFs of solid nodes with neither stiffness, mass nor constraint
         (nodes that only solid elements use); removed from ``free`` like supported DOFs,
         but they are not supports.
+    inputs : dict
+        The keyword arguments of :func:`build_model` besides the mesh (properties,
+        masses, springs, supports, links), so that the model can be rebuilt on another
+        mesh of the same groups (:func:`femmech.fe.refine.refined_model`).
     """
 
     mesh: Mesh
@@ -163,6 +167,7 @@ class FEModel:
     shells: ShellSet = field(default_factory=ShellSet)
     solids: SolidSet = field(default_factory=SolidSet)
     inactive: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))
+    inputs: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __repr__(self) -> str:
         kinds = ", ".join(f"{len(c)} {k}" for k, c in self.mesh.cells.items())
@@ -221,7 +226,10 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
     shells : dict[str, ShellProperty], optional
         Cell-set name → property of its triangle and quad cells (flat shell elements of
         :mod:`femmech.fe.elements.shell`, sharing nodes and DOFs with beams); every such
-        cell needs exactly one.
+        cell needs exactly one. quad9 and quad8 cells are MITC9 shells
+        (:mod:`femmech.fe.elements.shell9`); each quad8 cell gets a centre node
+        (:func:`femmech.fe.mesh.quad8_to_quad9`), appended after the mesh's nodes, and
+        the model's mesh is the converted one.
     solids : dict[str, SolidProperty], optional
         Cell-set name → property of its tetra, tetra10, hexahedron, hexahedron20 and
         hexahedron27 cells (:mod:`femmech.fe.elements.solid`, translations only); every such
@@ -243,13 +251,15 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
     -----
     ModelWarning
         For each finding of :func:`model_findings` (nearly coincident nodes, loose parts,
-        unit mix-ups), naming the nodes, groups and values.
+        unit mix-ups, badly shaped shell elements), naming the nodes, elements, groups
+        and values.
     """
     beams = {} if beams is None else beams
     shells = {} if shells is None else shells
     solids = {} if solids is None else solids
     _check_arguments(mesh, beams, masses, springs, supports, rigid_links, interpolating_links,
                      shells, solids)
+    mesh = quad8_to_quad9(mesh)  # MITC9 shells: quad8 cells get their centre nodes
     beam_set, Ke, Me, edofs = _beam_blocks(mesh, beams, bool(shells), bool(solids))
     shell_set, shell_stiff, shell_mass = shell_blocks(mesh, shells)
     n_dof = DOF_PER_NODE * mesh.n_nodes
@@ -279,7 +289,10 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
                                interpolating_links, shells, solids, node_tol=node_tol))
     return FEModel(mesh, K, M, T, free, beam_set, np.array(mass_nodes, dtype=np.int64), links,
                    (Tt @ K @ T).tocsr(), (Tt @ M @ T).tocsr(), shell_set, solid_set,
-                   np.flatnonzero(inactive))
+                   np.flatnonzero(inactive),
+                   dict(beams=beams, masses=masses, springs=springs, supports=supports,
+                        rigid_links=rigid_links, interpolating_links=interpolating_links,
+                        shells=shells, solids=solids, node_tol=node_tol))
 
 
 def _check_arguments(mesh, beams, masses, springs, supports, rigid_links, interpolating_links,
@@ -546,11 +559,12 @@ def model_findings(mesh: Mesh, beams=None, masses=(), springs=(), supports=(), r
                    node_tol: float | None = None) -> tuple[checks.Finding, ...]:
     """Suspicious inputs of :func:`build_model` (same arguments), without assembly.
 
-    Nearly coincident nodes that nothing joins, pieces that are free bodies by accident
-    and unit mix-ups (:mod:`femmech.fe.checks`). ``anchors``: further nodes held from
-    outside the model (group names or node indices, e.g. the attachments of mechanisms),
-    so that a piece holding one is not reported as loose. References are resolved as in
-    :func:`build_model` (ValueError naming the item when one does not exist).
+    Nearly coincident nodes that nothing joins, pieces that are free bodies by accident,
+    unit mix-ups and badly shaped shell elements (:mod:`femmech.fe.checks`). ``anchors``:
+    further nodes held from outside the model (group names or node indices, e.g. the
+    attachments of mechanisms), so that a piece holding one is not reported as loose.
+    References are resolved as in :func:`build_model` (ValueError naming the item when one
+    does not exist).
     """
     beams, shells, solids = beams or {}, shells or {}, solids or {}
     joined, held = [], [node_indices(mesh, a, "anchor") for a in anchors]
@@ -589,4 +603,7 @@ def model_findings(mesh: Mesh, beams=None, masses=(), springs=(), supports=(), r
     held = np.concatenate(held) if held else np.empty(0, dtype=np.int64)
     return tuple(checks.near_node_findings(points, cells, joined, node_tol)
                  + checks.loose_parts(mesh.n_nodes, cells, joined, held)
-                 + checks.unit_findings(extent, materials, sections, masses, element_mass))
+                 + checks.unit_findings(extent, materials, sections, masses, element_mass)
+                 + checks.shape_findings(points, cells, checks.cell_groups(
+                     mesh.cell_sets, list(shells), {k: c for k, c in cells.items()
+                                                    if k in kinds("shell")})))

@@ -7,6 +7,22 @@ principal axes. ``Iy = ∫ z² dA`` resists bending about y (deflection along z)
 the effective shear areas for shear forces along y and z; ``None`` means shear-rigid
 (Euler-Bernoulli) in that direction.
 
+Shear coefficients and Poisson's ratio. The shear area is ``As = k A`` with the shear
+coefficient ``k`` of the shape; for the solid rectangle and the circular tube it is
+Cowper's (1966), which depends on Poisson's ratio ν. A section is built before it meets a
+material, so :func:`rectangle`, :func:`tube` and :func:`circle` take their own ``nu``
+(default 0.3) and do not read ``Material.nu``: pass ``nu=material.nu`` to match them. The
+beam element then uses the material's shear modulus, ``G As = Material.shear_modulus · k A``
+(ν enters twice: through G from ``Material``, through k from the section). Scenes build
+their sections with the default ν = 0.3 whatever the material. The error is small: k of a
+rectangle is 0.833, 0.850 and 0.857 for ν = 0, 0.3 and 0.5, of a solid circle 0.857, 0.886
+and 0.900, so a material with ν anywhere in [0, 0.5] changes k from its ν = 0.3 value by
+at most 3.3 % (circle, ν = 0), and a frequency by less than that times the share of its
+strain energy in shear deformation. Thin-walled sections
+(:func:`i_section`, :func:`rectangular_hollow`) use ν-independent approximations (web or
+wall areas). Shells use ``k = 5/6`` for every material
+(:data:`femmech.fe.elements.shell.SHEAR_FACTOR`, see :class:`femmech.ShellProperty`).
+
 Stage 2 (fe, independent of mechanisms): uses only fe.materials.
 """
 
@@ -116,7 +132,9 @@ def rectangle(width: float, height: float, nu: float = 0.3, name: str = "rectang
     """Solid rectangle, ``width`` along local y and ``height`` along local z (m).
 
     Shear coefficient after Cowper (1966), J. Appl. Mech. 33:335, ``k = 10(1+ν)/(12+11ν)``
-    (0.850 for ν = 0.3).
+    (0.850 for ν = 0.3). ``nu`` is Poisson's ratio of this formula only (default 0.3):
+    give ``nu=material.nu`` to match the beam's material, whose shear modulus G the element
+    uses (module notes).
     """
     _positive(name, width=width, height=height)
     _poisson(name, nu)
@@ -133,7 +151,9 @@ def tube(outer_diameter: float, inner_diameter: float, nu: float = 0.3, name: st
     """Circular tube (m); ``inner_diameter = 0`` gives a solid circle.
 
     Shear coefficient after Cowper (1966):
-    ``k = 6(1+ν)(1+m²)² / ((7+6ν)(1+m²)² + (20+12ν)m²)``, ``m = d_i / d_o``.
+    ``k = 6(1+ν)(1+m²)² / ((7+6ν)(1+m²)² + (20+12ν)m²)``, ``m = d_i / d_o``. ``nu`` is
+    Poisson's ratio of this formula only (default 0.3, not read from a Material): give
+    ``nu=material.nu`` to match the beam's material (module notes).
     """
     _positive(name, outer_diameter=outer_diameter)
     _poisson(name, nu)

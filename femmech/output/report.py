@@ -41,6 +41,7 @@ figcaption{font-size:.85em;color:#444}
 ul.files{font-size:.9em}
 .warning{border-left:4px solid #c0392b;background:#fdecea;padding:.4em .8em}
 td.flagged{background:#fdecea;color:#8b1a10;font-weight:600}
+p.note{font-size:.85em;color:#444;margin-top:-.6em}
 """
 
 
@@ -50,12 +51,29 @@ class Table:
 
     A cell is a str, an int, a float (4 significant digits), a
     :class:`~femmech.output.formatting.Quantity` (value with unit and digits) or a
-    :class:`Flagged` text.
+    :class:`Flagged` text. ``note`` is a sentence shown under the table (e.g.
+    :func:`rigid_modes_note` under a table of natural frequencies).
     """
 
     caption: str
     header: tuple
     rows: tuple
+    note: str = ""
+
+
+def rigid_modes_note(rigid) -> str:
+    """The sentence under a table of natural modes that says how ``n_modes`` counts.
+
+    ``rigid``: the rigid-body flags of the modes (:attr:`femmech.ModeSet.rigid`), e.g.
+    ``"n_modes counts rigid-body modes: 6 of the 12 modes are rigid (0 Hz)."``; for no
+    rigid mode, ``"n_modes counts rigid-body modes: none of the 12 modes is rigid."``.
+    """
+    flags = [bool(r) for r in rigid]
+    n, k = len(flags), sum(flags)
+    if not k:
+        return f"n_modes counts rigid-body modes: none of the {n} modes is rigid."
+    return f"n_modes counts rigid-body modes: {k} of the {n} modes {'is' if k == 1 else 'are'}" \
+           " rigid (0 Hz)."
 
 
 @dataclass(frozen=True)
@@ -139,8 +157,9 @@ def render_table(table: Table) -> str:
     :func:`~femmech.output.formatting.format_value`."""
     head = "".join(f"<th>{_text(h)}</th>" for h in table.header)
     body = "".join("<tr>" + "".join(_cell(c) for c in row) + "</tr>" for row in table.rows)
+    note = f'<p class="note">{html.escape(table.note)}</p>' if table.note else ""
     return (f"<table><caption>{html.escape(table.caption)}</caption><thead><tr>{head}</tr>"
-            f"</thead><tbody>{body}</tbody></table>")
+            f"</thead><tbody>{body}</tbody></table>{note}")
 
 
 def _figure(fig: Figure) -> str:

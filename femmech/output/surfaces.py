@@ -31,6 +31,16 @@ _CORNER_TYPE = {"tetra": "tetra", "tetra10": "tetra", "hexahedron": "hexahedron"
 _CORNERS = {"tetra": 4, "hexahedron": 8, "wedge": 6, "pyramid": 5}
 _BY_WIDTH = {4: "tetra", 10: "tetra10", 8: "hexahedron", 20: "hexahedron20", 6: "wedge"}
 
+# Quadratic shell cells are drawn as linear sub-faces through their mid-side and centre
+# nodes (meshio node order: corners, then mid-sides, then the centre), so that the drawn
+# surface passes through every node.
+_LINEAR_FACES = {
+    "triangle6": ("triangle", ((0, 3, 5), (3, 1, 4), (5, 4, 2), (3, 4, 5))),
+    "quad9": ("quad", ((0, 4, 8, 7), (4, 1, 5, 8), (8, 5, 2, 6), (7, 8, 6, 3))),
+    "quad8": ("triangle", ((0, 4, 7), (4, 1, 5), (5, 2, 6), (6, 3, 7), (4, 5, 7),
+                           (5, 6, 7))),
+}
+
 
 def _typed_cells(cells) -> dict[str, np.ndarray]:
     """``{meshio type: connectivity}`` from a dict, or from one array (type by its width)."""
@@ -147,8 +157,13 @@ def surface_faces(model: FEModel) -> dict[str, np.ndarray]:
     -------
     dict[str, ndarray]
         ``"triangle"`` (n, 3) and ``"quad"`` (n, 4) node indices; empty for a beam model.
+        Quadratic shells (``triangle6``, ``quad8``, ``quad9``) come as linear sub-faces.
     """
-    out = {k: [v] for k, v in shell_cells(model).items()}
+    out = {}
+    for kind, cells in shell_cells(model).items():
+        base, subs = _LINEAR_FACES.get(kind, (kind, None))
+        out.setdefault(base, []).append(
+            cells if subs is None else np.concatenate([cells[:, list(f)] for f in subs]))
     for kind, faces in boundary_faces(solid_cells(model)).items():
         out.setdefault(kind, []).append(faces)
     return {k: np.concatenate(v) for k, v in out.items()}

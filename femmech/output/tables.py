@@ -1,6 +1,7 @@
 """Frequency tables of a mode set: plain text for reports and logs, CSV for spreadsheets.
 
-Stage 7 (output): uses analysis.modes and output.export.
+Stage 7 (output): uses analysis.modes, analysis.discretisation and output (export,
+formatting, report).
 """
 
 from __future__ import annotations
@@ -9,8 +10,11 @@ import csv
 import io
 from pathlib import Path
 
+from femmech.analysis.discretisation import DiscretisationEstimate
 from femmech.analysis.modes import ModeSet
 from femmech.output.export import atomic_path
+from femmech.output.formatting import Quantity
+from femmech.output.report import Flagged
 
 _HEADER = ("mode", "freq_hz", "rigid", "residual")
 
@@ -72,3 +76,44 @@ def write_frequency_csv(modes: ModeSet, filename) -> Path:
     with atomic_path(filename) as tmp:
         tmp.write_text(buffer.getvalue(), encoding="utf-8")
     return Path(filename)
+
+
+def error_budget_columns(estimate: DiscretisationEstimate, reduction=None
+                         ) -> tuple[tuple, list]:
+    """Report columns of the error budget per mode: the discretisation estimate and,
+    with a reduction estimate, their sum.
+
+    Parameters
+    ----------
+    estimate : DiscretisationEstimate
+        One entry per mode of the table (:func:`femmech.analysis.discretisation.
+        discretisation_error_of`).
+    reduction : array_like (n,), optional
+        Estimated relative error of the reduction per mode (:attr:`ModeSet.error_estimate`).
+
+    Returns
+    -------
+    header : tuple of str
+    cells : list of tuple
+        Per mode: a :class:`Quantity` for a trusted estimate, ``"–"`` for a rigid-body
+        mode, a highlighted :class:`~femmech.output.report.Flagged` text otherwise (a lower
+        bound or "?", with the reason), never a plain number that may be wrong.
+    """
+    header = ("discretisation error (h/2 estimate)",)
+    if reduction is not None:
+        header += ("total estimated error",)
+    cells = []
+    for k in range(len(estimate.freq_hz)):
+        flag = estimate.flag[k]
+        if flag == "rigid":
+            row = ("–",) + (("–",) if reduction is not None else ())
+        elif flag:
+            row = (Flagged(estimate.describe(k)),) + (
+                (Flagged("?"),) if reduction is not None else ())
+        else:
+            disc = abs(float(estimate.error[k]))
+            row = (Quantity(disc, digits=2),) + (
+                (Quantity(disc + abs(float(reduction[k])), digits=2),)
+                if reduction is not None else ())
+        cells.append(row)
+    return header, cells

@@ -96,6 +96,7 @@ class ModesSpec:
     vtu: bool
     series: bool = False
     animate: tuple = ()
+    discretisation_error: bool = False
 
 
 @dataclass(frozen=True)
@@ -218,7 +219,7 @@ def _only_part(r: Reader, parts: dict) -> str:
 
 
 _KEYS = {"modes": ("part", "n_modes", "band_hz", "model", "images", "vtu", "series",
-                   "animate"),
+                   "animate", "discretisation_error"),
          "sweep": ("angles", "n_modes", "speeds", "mechanism", "track", "mode_images_at"),
          "stability": ("speeds", "n_steps", "angle_period", "rayleigh", "tol", "rtol",
                        "max_steps"),
@@ -302,7 +303,8 @@ def _modes(t: Reader, parts, mechanisms, has_mounts) -> ModesSpec:
     if len(set(animate)) > MAX_ANIMATIONS:
         raise t.error("animate", f"at most {MAX_ANIMATIONS} animations (MAX_ANIMATIONS)")
     return ModesSpec(part, n_modes, band, model, images, t.boolean("vtu", True),
-                     t.boolean("series", False), tuple(sorted(set(animate))))
+                     t.boolean("series", False), tuple(sorted(set(animate))),
+                     t.boolean("discretisation_error", False))
 
 
 def _needs_machine(t: Reader, parts, has_mounts, what: str) -> None:

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from femmech.coupling import Attachment, Mount
-from femmech.errors import ModelWarning, UserCodeError, did_you_mean, name_list
+from femmech.errors import ModelWarning, SceneError, UserCodeError, did_you_mean, name_list
 from femmech.fe import sections as sec
 from femmech.fe.constraints import InterpolatingLink, RigidLink, Support
 from femmech.fe.dofs import COMPONENTS
@@ -146,14 +146,14 @@ def finding_lines(prepared: Prepared) -> list[str]:
 def part_mesh(scene: Scene, part: PartSpec) -> Mesh:
     """The part's mesh: read from its file or generated; edge groups turned into nodes."""
     spec = part.mesh
+    for where, key, ref in _node_refs(scene, part) if spec.auto else ():
+        if not isinstance(ref, str):  # node indices depend on the sized counts
+            raise fail(scene, part.where, "mesh", f"with mesh = 'auto' give nodes by group"
+                       f" name, not {np.ravel(ref).tolist()} ([{where}] {key})")
     try:
         if spec.file is not None:
             mesh = read_mesh(spec.file)
         elif spec.auto:  # mesh = "auto": counts sized for the part's band
-            for where, key, ref in _node_refs(scene, part):
-                if not isinstance(ref, str):  # indices depend on the sized counts
-                    raise fail(scene, part.where, "mesh", f"with mesh = 'auto' give nodes by"
-                               f" group name, not {ref!r} ([{where}] {key})")
             args = _model_args(scene, part)
             mesh = auto_mesh(spec, args["beams"], args["shells"] or {},
                              lambda m: part_model(scene, part, m))
@@ -164,6 +164,8 @@ def part_mesh(scene: Scene, part: PartSpec) -> Mesh:
         else:
             mesh = members_frame(**spec.params)
         mesh = edges_to_node_sets(mesh, spec.edge_node_groups)
+    except SceneError:  # from part_model of an auto mesh: already located
+        raise
     except (ValueError, FileNotFoundError) as exc:
         key = "mesh" if spec.file is not None else None
         raise fail(scene, spec.where, key, str(exc)) from None
@@ -400,6 +402,9 @@ def reduction_key_data(scene: Scene, part: PartSpec, f_max_hz: float | None = No
     del data["name"]
     if part.mesh.file is not None:
         data["mesh"]["file"] = hashlib.sha256(Path(part.mesh.file).read_bytes()).hexdigest()
+    if part.mesh.auto:  # mesh = "auto": the counts follow the target and the band
+        data["mesh"]["auto"] = {"target_error": part.mesh.target_error,
+                                "band": list(part.mesh.band)}
     if f_max_hz is not None:
         data["reduction"].update(n_modes=None, cutoff_hz=None, f_max_hz=float(f_max_hz))
     return {"femmech": __version__, "format": FORMAT_VERSION,

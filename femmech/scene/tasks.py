@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from femmech.analysis.discretisation import discretisation_error_of
 from femmech.analysis.drive_events import spring_forces, trip_and_brake
 from femmech.analysis.modes import modes, superelement_modes
 from femmech.analysis.reference import Comparison, compare_coupled
@@ -52,10 +53,11 @@ from femmech.output.charts import format_speed, needs_log_scale, set_angle_axis,
 from femmech.output.export import atomic_path
 from femmech.output.formatting import Quantity, format_value
 from femmech.output.histories import plot_event_histories, write_history_csv
-from femmech.output.report import Figure, Flagged, Section, Table
+from femmech.output.report import Figure, Flagged, Section, Table, rigid_modes_note
 from femmech.output.series import write_mode_series
 from femmech.output.stability_charts import plot_stability_chart
 from femmech.output.sweeps import plot_quasi_frequencies
+from femmech.output.tables import error_budget_columns
 from femmech.scene.analyses import MAX_DRIVE_EVALUATIONS
 from femmech.scene.build import machine_mounts
 from femmech.scene.chain import (
@@ -93,7 +95,8 @@ def _write_csv(path, header, rows) -> None:
 def run_modes(ws, spec, out):
     """Natural modes of a part (full FE model or its superelement)."""
     drawn = spec.images or spec.vtu or spec.series or spec.animate
-    model = ws.model(spec.part) if (spec.model == "full" or drawn) else None
+    model = ws.model(spec.part) if (spec.model == "full" or drawn
+                                    or spec.discretisation_error) else None
     with ws.timed("eigen solve"):
         if spec.model == "full":
             result = modes(model, n_modes=spec.n_modes, band_hz=spec.band_hz)
@@ -137,13 +140,27 @@ def run_modes(ws, spec, out):
     solver = f", factorisation {result.solver}" if result.solver else ""
     text = (f"Part {spec.part!r}, {spec.model} model ({result.method} solver{solver}):"
             f" {result.n_modes} modes.",)
+    extra = {}
+    if spec.discretisation_error:  # opt-in: one h/2 refinement of the full model
+        with ws.timed("discretisation estimate"):
+            disc = discretisation_error_of(result, model, reduced=spec.model != "full")
+        more, cells = error_budget_columns(disc, est)
+        header, rows = header + more, tuple(r + c for r, c in zip(rows, cells, strict=True))
+        text += (f"Discretisation error: estimated by one uniform refinement (h/2, free DOFs"
+                 f" {' → '.join(map(str, disc.n_dof))}) and Richardson extrapolation with"
+                 f" rate h^{disc.rate:g} ({', '.join(disc.kinds)} elements); highlighted"
+                 " estimates are not trusted (their reason is given)."
+                 + (" Total = discretisation + reduction." if est is not None else ""),)
+        extra["discretisation_error"] = _list(np.where(disc.trusted, disc.error, np.nan))
     with ws.timed("mass participation"):
         tables, notes = participation_tables(model if model is not None else
                                              ws.model(spec.part), result, spec.part)
     section = Section("Natural modes", text + notes,
-                      (Table("Natural frequencies", header, rows), *tables),
+                      (Table("Natural frequencies", header, rows,
+                             rigid_modes_note(result.rigid)), *tables),
                       tuple(figures), tuple(files), gallery=True)
-    return section, {"part": spec.part, "model": spec.model, "freq_hz": _list(result.freq_hz)}
+    return section, {"part": spec.part, "model": spec.model, "freq_hz": _list(result.freq_hz),
+                     **extra}
 
 
 def run_sweep(ws, spec, out):

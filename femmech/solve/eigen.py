@@ -28,7 +28,12 @@ from femmech.solve.arpack import _arpack
 from femmech.solve.dense import dense_symmetric
 from femmech.solve.lanczos import _FarShiftError, _lowest_pairs
 from femmech.solve.pencil import _n_mass, default_shift, eigenvalue_scale, factorize
-from femmech.solve.residuals import _residual_terms, normalize_modes, residual_limits
+from femmech.solve.residuals import (
+    _residual_terms,
+    normalize_modes,
+    residual_limits,
+    residual_message,
+)
 from femmech.solve.sturm import _complete_cluster, _cut_above, inertia_below
 
 MAX_DEFLATIONS = 10
@@ -190,11 +195,9 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
     num, den = _residual_terms(K, M, omega2, X, 1e-6 * scale)
     res = num / np.where(den > 0, den, 1.0)
     limits = residual_limits(K, X, den)
-    if res.size and (res > limits).any():
-        k = int(np.argmax(res / limits))
-        warnings.warn(f"eigen solve: relative residual {res[k]:.2e} of mode {k + 1} exceeds"
-                      f" {limits[k]:.1e} (1e-6, or 100 times its round-off level)",
-                      FemmechWarning, stacklevel=2)
+    message = residual_message(res, limits, omega2)
+    if message:
+        warnings.warn(message, FemmechWarning, stacklevel=2)
     if method == "dense":
         count, cut = None, None
     solver = None if method == "dense" else (

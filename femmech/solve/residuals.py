@@ -64,3 +64,36 @@ def residual_limits(K, vectors, den) -> np.ndarray:
     x_norm = np.linalg.norm(vectors, axis=0)
     roundoff = 100 * np.finfo(float).eps * k_norm * x_norm / np.where(den > 0, den, np.inf)
     return np.maximum(RESIDUAL_TOL, roundoff)
+
+
+MAX_NAMED = 5
+"""Modes named in one residual warning; the others are counted."""
+
+
+def residual_message(residual, limits, omega2) -> str | None:
+    """The warning text for modes whose relative residual exceeds its limit, or None.
+
+    Names each such mode by its number (1-based, in the order computed) and frequency,
+    the worst (largest residual / limit) first, e.g. ``"eigen solve: mode 3 (f = 12.5
+    Hz): relative residual 2.1e-05 exceeds 1.0e-06; ..."``.
+
+    Parameters
+    ----------
+    residual, limits : ndarray (n_modes,)
+        :func:`residuals` and :func:`residual_limits`.
+    omega2 : ndarray (n_modes,), rad²/s²
+        Eigenvalues (negative round-off of rigid-body modes shows as f = 0 Hz).
+    """
+    residual, limits = np.asarray(residual, dtype=float), np.asarray(limits, dtype=float)
+    over = np.flatnonzero(residual > limits)
+    if not over.size:
+        return None
+    ratio = np.divide(residual[over], limits[over], out=np.full(over.size, np.inf),
+                      where=limits[over] > 0)
+    over = over[np.argsort(-ratio, kind="stable")]
+    freq = np.sqrt(np.clip(np.asarray(omega2, dtype=float), 0.0, None)) / (2 * np.pi)
+    named = [f"mode {k + 1} (f = {freq[k]:.4g} Hz): relative residual {residual[k]:.2e}"
+             f" exceeds {limits[k]:.1e}" for k in over[:MAX_NAMED]]
+    more = f"; and {over.size - MAX_NAMED} more modes" if over.size > MAX_NAMED else ""
+    return ("eigen solve: " + "; ".join(named) + more
+            + " (limit: 1e-6, or 100 times the residual's round-off level)")

@@ -66,7 +66,8 @@ def test_two_unit_chain_matches_hand_assembly(unit):
     assert np.allclose(M, M_hand, rtol=1e-14, atol=0)
     assert np.allclose(C, C_hand, rtol=1e-14, atol=0)
     assert not B.any()
-    assert np.allclose(ch.M(phi), M) and np.allclose(ch.C(phi), C)
+    assert np.allclose(ch.M(phi), M)
+    assert np.allclose(ch.C(phi), C)
     assert ch.M(np.array([[0.1, 0.2]])).shape == (1, 2, 4, 4)
 
 
@@ -104,7 +105,7 @@ def test_large_chain_is_sparse_and_banded(unit):
     assert C.nnz < 5 * ch.n
 
 
-@pytest.mark.parametrize("kwargs, message", [
+@pytest.mark.parametrize(("kwargs", "message"), [
     (dict(node_inertia=[1.0, -1.0], spring=[1.0], unit_node=[0], phase=0.0),
      r"node_inertia\[1\]"),
     (dict(node_inertia=[1.0, 1.0], spring=[0.0], unit_node=[0], phase=0.0), r"spring\[0\]"),
