@@ -36,7 +36,7 @@ _GENERATOR_KEYS = {"grid_frame": ("kind", "bays", "size", "subdivisions"),
                    "rectangular_plate": ("kind", "a", "b", "divisions", "element"),
                    "box": ("kind", "length", "width", "height", "divisions", "end_plates",
                            "element")}
-SHELL_GENERATOR_ELEMENTS = ("quad", "triangle")
+SHELL_GENERATOR_ELEMENTS = ("quad", "triangle", "quad9", "triangle6")
 """Cell kinds the shell generators make from a scene (the kinds with measured sizing
 constants, :data:`femmech.fe.sizing.SHELL_BENDING`)."""
 AUTO_TARGET_ERROR = 1e-3
