@@ -164,15 +164,9 @@ def shell_matrices(points, cells, E, nu, rho, thickness, shear_factor=SHEAR_FACT
     n, k = cells.shape
     if n == 0:
         return np.zeros((0, 6 * k, 6 * k)), np.zeros((0, 6 * k, 6 * k))
-    if n > ELEMENT_CHUNK:  # batches of ELEMENT_CHUNK elements into the result arrays
-        per = [np.broadcast_to(np.asarray(p, dtype=float), (n,))
-               for p in (E, nu, rho, thickness, drilling)]
-        K, M = np.empty((n, 6 * k, 6 * k)), np.empty((n, 6 * k, 6 * k))
-        for start in range(0, n, ELEMENT_CHUNK):
-            part = slice(start, start + ELEMENT_CHUNK)
-            K[part], M[part] = shell_matrices(points, cells[part], *(p[part] for p in per[:4]),
-                                              shear_factor, drilling=per[4][part])
-        return K, M
+    if n > ELEMENT_CHUNK:
+        return batched(shell_matrices, ELEMENT_CHUNK, points, cells, E, nu, rho, thickness,
+                       shear_factor, drilling)
     R, xy, z = shell_frames(np.asarray(points, dtype=float), cells)
     E, nu, rho, t = (np.broadcast_to(np.asarray(p, dtype=float), (n,)).copy()
                      for p in (E, nu, rho, thickness))
@@ -189,12 +183,42 @@ def shell_matrices(points, cells, E, nu, rho, thickness, shear_factor=SHEAR_FACT
                                C * (t**3 / 12.0)[:, None, None], shear_factor * G * t, t)
     else:
         raise ValueError(f"shell cells must have 3 or 4 nodes, got {k}")
+    return global_matrices(R, z if k == 4 else None, Km, Kb, N, dN, wdet, G, t, rho,
+                           drilling)
+
+
+def batched(matrices, chunk: int, points, cells, E, nu, rho, thickness, shear_factor,
+            drilling, **options):
+    """``matrices(points, cells, ...)`` of a shell kind in batches of ``chunk`` elements,
+    written into the result arrays (bounds the temporaries); the per-element properties
+    (float or (n_elements,)) are sliced with the cells, ``options`` passed unchanged."""
+    n, size = len(cells), 6 * cells.shape[1]
+    per = [np.broadcast_to(np.asarray(p, dtype=float), (n,))
+           for p in (E, nu, rho, thickness, drilling)]
+    K, M = np.empty((n, size, size)), np.empty((n, size, size))
+    for start in range(0, n, chunk):
+        part = slice(start, start + chunk)
+        K[part], M[part] = matrices(points, cells[part], *(p[part] for p in per[:4]),
+                                    shear_factor, drilling=per[4][part], **options)
+    return K, M
+
+
+def global_matrices(R, z, Km, Kb, N, dN, wdet, G, t, rho, drilling):
+    """Element stiffness and mass in global axes from the local parts of a flat shell.
+
+    ``Km`` (n, 2k, 2k) membrane (u, v), ``Kb`` (n, 3k, 3k) bending (w, θx, θy), both
+    local; the drilling penalty (``drilling · G``), the consistent mass (``ρ t``,
+    ``ρ t³ / 12``) from ``N`` (q, k), ``dN`` (n, q, 2, k) and ``wdet`` (n, q) are added
+    here; ``z`` (n, k): node offsets from the element plane (rigid offsets), or None.
+    Returns K, M (n, 6k, 6k) on the DOFs ``ux … rz`` per node, global axes.
+    """
+    n, k = wdet.shape[0], N.shape[-1]
     Km += _drilling(N, dN, wdet, drilling * G * t)
     K = np.zeros((n, 6 * k, 6 * k))
     _scatter(K, Km, _MEMBRANE, k)
     _scatter(K, Kb, _BENDING, k)
     M = _mass(N, wdet, rho * t, rho * t**3 / 12.0)
-    T = _offsets(z) if k == 4 else None
+    T = None if z is None else _offsets(z)
     return _to_global(R, K, T), _to_global(R, M, T)
 
 

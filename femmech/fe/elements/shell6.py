@@ -75,20 +75,15 @@ import numpy as np
 
 from femmech.fe.elements.registry import ElementType, register
 from femmech.fe.elements.shell import (
-    _BENDING,
-    _MEMBRANE,
     DRILLING,
     ELEMENT_CHUNK,
     SHEAR_FACTOR,
-    _drilling,
     _expand_uv,
     _integrate,
-    _mass,
     _membrane_b,
-    _offsets,
     _plane_stress,
-    _scatter,
-    _to_global,
+    batched,
+    global_matrices,
     shell_frames,
 )
 
@@ -305,14 +300,8 @@ def shell6_matrices(points, cells, E, nu, rho, thickness, shear_factor=SHEAR_FAC
         return np.zeros((0, 36, 36)), np.zeros((0, 36, 36))
     chunk = ELEMENT_CHUNK // 2  # 36 x 36 blocks: about 2.3 times the memory of a quad's
     if n > chunk:
-        per = [np.broadcast_to(np.asarray(p, dtype=float), (n,))
-               for p in (E, nu, rho, thickness, drilling)]
-        K, M = np.empty((n, 36, 36)), np.empty((n, 36, 36))
-        for start in range(0, n, chunk):
-            part = slice(start, start + chunk)
-            K[part], M[part] = shell6_matrices(points, cells[part], *(p[part] for p in per[:4]),
-                                               shear_factor, drilling=per[4][part])
-        return K, M
+        return batched(shell6_matrices, chunk, points, cells, E, nu, rho, thickness,
+                       shear_factor, drilling)
     R, xy, z = frames6(np.asarray(points, dtype=float), cells)
     E, nu, rho, t, drill = (np.broadcast_to(np.asarray(p, dtype=float), (n,)).copy()
                             for p in (E, nu, rho, thickness, drilling))
@@ -320,14 +309,8 @@ def shell6_matrices(points, cells, E, nu, rho, thickness, shear_factor=SHEAR_FAC
     C = _plane_stress(E, nu)
     N, dN_xy, _, wdet = _quadrature(xy)
     Km = _expand_uv(_integrate(_membrane_b(dN_xy), C * t[:, None, None], wdet), 6)
-    Km += _drilling(N, dN_xy, wdet, drill * G * t)
     Kb = _bending(xy, C * (t**3 / 12.0)[:, None, None], shear_factor * G * t)
-    K = np.zeros((n, 36, 36))
-    _scatter(K, Km, _MEMBRANE, 6)
-    _scatter(K, Kb, _BENDING, 6)
-    M = _mass(N, wdet, rho * t, rho * t**3 / 12.0)
-    T = _offsets(z)
-    return _to_global(R, K, T), _to_global(R, M, T)
+    return global_matrices(R, z, Km, Kb, N, dN_xy, wdet, G, t, rho, drill)
 
 
 register(ElementType("triangle6", "shell", shell6_matrices))

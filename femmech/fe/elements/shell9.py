@@ -71,20 +71,16 @@ import numpy as np
 
 from femmech.fe.elements.registry import ElementType, register
 from femmech.fe.elements.shell import (
-    _BENDING,
-    _MEMBRANE,
     DRILLING,
     ELEMENT_CHUNK,
     SHEAR_FACTOR,
-    _drilling,
     _expand_uv,
     _integrate,
-    _mass,
     _membrane_b,
-    _offsets,
     _plane_stress,
-    _scatter,
-    _to_global,
+    batched,
+    global_matrices,
+    shell_frames,
 )
 
 NODES = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [0.0, -1.0],
@@ -158,22 +154,12 @@ def frames9(points: np.ndarray, cells: np.ndarray):
     ValueError
         For a degenerate element (zero area), naming the first one.
     """
+    try:  # the frame of the corners, as for the 4-node quad
+        R, _, _ = shell_frames(points, cells[:, :4])
+    except ValueError as err:
+        raise ValueError(f"quad9 {err}") from None
     X = points[cells]
-    centre = X.mean(axis=1)
-    normal = np.cross(X[:, 2] - X[:, 0], X[:, 3] - X[:, 1])
-    ex = X[:, 1] + X[:, 2] - X[:, 0] - X[:, 3]
-    size = np.linalg.norm(normal, axis=1)
-    scale = max(float(np.ptp(points, axis=0).max()), 1e-300)
-    bad = np.flatnonzero(~(size > 1e-12 * scale**2))
-    if bad.size:
-        e = bad[0]
-        raise ValueError(f"quad9 shell element {e} (nodes {cells[e].tolist()}) has zero"
-                         f" area ({bad.size} degenerate elements in all)")
-    ez = normal / size[:, None]
-    ex = ex - np.sum(ex * ez, axis=1)[:, None] * ez
-    ex /= np.linalg.norm(ex, axis=1)[:, None]
-    R = np.stack([ex, np.cross(ez, ex), ez], axis=1)
-    local = np.einsum("eij,ekj->eki", R, X - centre[:, None, :])
+    local = np.einsum("eij,ekj->eki", R, X - X.mean(axis=1)[:, None, :])
     return R, local[:, :, :2], local[:, :, 2]
 
 
@@ -271,15 +257,8 @@ def shell9_matrices(points, cells, E, nu, rho, thickness, shear_factor=SHEAR_FAC
         return np.zeros((0, 54, 54)), np.zeros((0, 54, 54))
     chunk = ELEMENT_CHUNK // 4  # 54 x 54 blocks: about 5 times the memory of a quad's
     if n > chunk:
-        per = [np.broadcast_to(np.asarray(p, dtype=float), (n,))
-               for p in (E, nu, rho, thickness, drilling)]
-        K, M = np.empty((n, 54, 54)), np.empty((n, 54, 54))
-        for start in range(0, n, chunk):
-            part = slice(start, start + chunk)
-            K[part], M[part] = shell9_matrices(points, cells[part], *(p[part] for p in per[:4]),
-                                               shear_factor, drilling=per[4][part],
-                                               tying=tying)
-        return K, M
+        return batched(shell9_matrices, chunk, points, cells, E, nu, rho, thickness,
+                       shear_factor, drilling, tying=tying)
     R, xy, z = frames9(np.asarray(points, dtype=float), cells)
     E, nu, rho, t, drill = (np.broadcast_to(np.asarray(p, dtype=float), (n,)).copy()
                             for p in (E, nu, rho, thickness, drilling))
@@ -287,14 +266,8 @@ def shell9_matrices(points, cells, E, nu, rho, thickness, shear_factor=SHEAR_FAC
     C = _plane_stress(E, nu)
     N, dN_xy, _, wdet = _gauss(xy)
     Km = _expand_uv(_integrate(_membrane_b(dN_xy), C * t[:, None, None], wdet), 9)
-    Km += _drilling(N, dN_xy, wdet, drill * G * t)
     Kb = _bending(xy, C * (t**3 / 12.0)[:, None, None], shear_factor * G * t, TYING[tying])
-    K = np.zeros((n, 54, 54))
-    _scatter(K, Km, _MEMBRANE, 9)
-    _scatter(K, Kb, _BENDING, 9)
-    M = _mass(N, wdet, rho * t, rho * t**3 / 12.0)
-    T = _offsets(z)
-    return _to_global(R, K, T), _to_global(R, M, T)
+    return global_matrices(R, z, Km, Kb, N, dN_xy, wdet, G, t, rho, drill)
 
 
 register(ElementType("quad9", "shell", shell9_matrices))
