@@ -361,35 +361,6 @@ def band_distance(freq_hz, lo_hz, hi_hz) -> np.ndarray:
     return np.maximum(1.0 - f / lo_hz, f / hi_hz - 1.0)
 
 
-def frozen_matrices(chain, phi) -> tuple[np.ndarray, np.ndarray]:
-    """Dense assembled ``M(φ)`` and ``C(φ, Ω = 0)`` of a chain at all angles at once.
-
-    The same matrices as ``chain.M(phi)``, ``chain.C(phi)`` (same coordinates), built
-    from the shaft data and one vectorised call of ``chain.unit_matrices`` instead of
-    one sparse assembly per angle. ``phi`` (n_angles,) rad → two (n_angles, n, n).
-    """
-    phi = np.atleast_1d(np.asarray(phi, dtype=float))
-    n, dof = chain.n, chain.node_dof
-    M0, C0 = np.zeros((n, n)), np.zeros((n, n))
-    free = dof >= 0
-    M0[dof[free], dof[free]] += chain.node_inertia[free]
-    C0[dof[free], dof[free]] += chain.ground[free]
-    for i, j, k in zip(dof[:-1], dof[1:], chain.spring, strict=True):
-        for r, c, v in ((i, i, k), (j, j, k), (i, j, -k), (j, i, -k)):
-            if r >= 0 and c >= 0:
-                C0[r, c] += v
-    Mu, _, Cu = chain.unit_matrices(phi)  # (n_angles, n_units, m, m)
-    dofs = chain.unit_dofs
-    r = np.broadcast_to(dofs[:, :, None], Mu.shape[1:])
-    c = np.broadcast_to(dofs[:, None, :], Mu.shape[1:])
-    keep = (r >= 0) & (c >= 0)  # units own distinct coordinates: no repeated (r, c)
-    M = np.repeat(M0[None], phi.size, axis=0)
-    C = np.repeat(C0[None], phi.size, axis=0)
-    M[:, r[keep], c[keep]] += Mu[:, keep]
-    C[:, r[keep], c[keep]] += Cu[:, keep]
-    return M, C
-
-
 def frozen_eigen(M, C, phi=None) -> tuple[np.ndarray, np.ndarray]:
     """All eigenpairs of ``C v = λ M v`` at each angle (batched, dense).
 
@@ -456,15 +427,21 @@ def frequency_bands(chain, phi=None, n_angles: int = DEFAULT_ANGLES) -> Frequenc
     """All quasi-eigenfrequencies of the frozen chain over the revolution (Hz)."""
     phi = _angles(phi, n_angles)
     with threads.solve_phase():
-        lam, _ = frozen_eigen(*frozen_matrices(chain, phi), phi)
+        lam, _ = frozen_eigen(chain.M(phi), chain.C(phi), phi)
     return FrequencyBands(phi, _frequencies(lam))
+
+
+def _distances(freq, lo, hi, keep) -> np.ndarray:
+    """:func:`band_distance` of the kept branches (``keep``: bool, shape of ``freq``),
+    ``inf`` for the others: S + (K,)."""
+    return np.where(keep[..., None], band_distance(freq, lo, hi), np.inf)
 
 
 def margin_of(bands: FrequencyBands, speed_rpm, harmonics: int, n_modes=None) -> Margin:
     """:class:`Margin` of given frequency bands (see :func:`resonance_margin`)."""
     lo, hi = harmonic_bands(speed_rpm, harmonics)
     freq = np.asarray(bands.freq_hz)
-    d = np.where(_kept(freq, n_modes)[..., None], band_distance(freq, lo, hi), np.inf)
+    d = _distances(freq, lo, hi, _kept(freq, n_modes))
     a, i, k = np.unravel_index(int(np.argmin(d)), d.shape)
     per_branch = d.min(axis=(0, 2))
     return Margin(float(d[a, i, k]), int(i), int(k) + 1, float(bands.phi[a]),
@@ -541,7 +518,8 @@ class _Problem:
 
     def matrices(self, x):
         self.counts["builds"] += 1
-        return frozen_matrices(self.build(self.values(x)), self.phi)
+        chain = self.build(self.values(x))
+        return chain.M(self.phi), chain.C(self.phi)
 
     def evaluate(self, x):
         """(KS, dKS/dx, true margin) at x."""
@@ -554,8 +532,7 @@ class _Problem:
         freq = _frequencies(lam)
         keep = _kept(freq, self.n_modes)
         ks, dks_df = ks_margin(freq, self.lo, self.hi, self.rho, keep)
-        margin = float(np.where(keep[..., None], band_distance(freq, self.lo, self.hi),
-                                np.inf).min())
+        margin = float(_distances(freq, self.lo, self.hi, keep).min())
         safe = freq > 1e-9 * max(float(freq.max()), 1e-300)  # rigid-body modes: no df/dλ
         g = np.where(safe, dks_df / (8 * np.pi**2 * np.where(safe, freq, 1.0)), 0.0)
         grad = np.array([self._directional(x, j, lam, V, g)
@@ -568,9 +545,7 @@ class _Problem:
         M, C = self.matrices(x)
         self.counts["evaluations"] += 1
         freq = _frequencies(np.linalg.eigvalsh(_standard(M, C)))
-        keep = _kept(freq, self.n_modes)
-        return float(np.where(keep[..., None], band_distance(freq, self.lo, self.hi),
-                              np.inf).min())
+        return float(_distances(freq, self.lo, self.hi, _kept(freq, self.n_modes)).min())
 
     def _directional(self, x, j, lam, V, g) -> float:
         """dKS/dx_j = Σ g vᵀ (dC - λ dM) v, matrices differenced in x_j (central inside

@@ -12,7 +12,6 @@ from femmech.chain.synthesis import (
     band_distance,
     frequency_bands,
     frozen_eigen,
-    frozen_matrices,
     harmonic_bands,
     ks_margin,
     margin_sensitivities,
@@ -161,16 +160,6 @@ def test_one_dof_frequency_sympy():
 
 
 # --- matrices and gradients ---------------------------------------------------------------
-
-def test_frozen_matrices_equal_chain_matrices():
-    c = chain(follower_unit(CAM, 1e-3, 0.5, 2e5), 4, 0.2, 0.03, end_length=0.1,
-              left=End.fixed(), right=End.flywheel(0.1), phases=[0.0, 1.0, 2.0, 3.0])
-    phi = np.linspace(0, TWO_PI, 9)
-    M, C = frozen_matrices(c, phi)
-    # same sums in a different order: equal to round-off (1e-12 of the largest entry)
-    np.testing.assert_allclose(M, c.M(phi), rtol=0, atol=1e-12 * np.abs(M).max())
-    np.testing.assert_allclose(C, c.C(phi), rtol=0, atol=1e-12 * np.abs(C).max())
-
 
 def _ks(values, rho=200.0):
     return margin_sensitivities(build, PARAMS, values, SPEED, K, n_angles=24, rho=rho)
