@@ -1,9 +1,31 @@
-"""Benchmark suite: every benchmark of issue 10 from one entry point, one table file each.
+"""Benchmark suite: femmech against its peers (issue 24) and the issue-10 entries, one table
+file each.
 
 Usage::
 
-    python benchmarks/run.py [--size tiny|small|medium|large] [--only NAME ...]
-                             [--out DIR] [--blas-threads N]
+    python benchmarks/run.py [--suite peers|issue10] [--size tiny|small|medium|large]
+                             [--repeats N] [--only NAME ...] [--out DIR] [--blas-threads N]
+
+The default suite ``peers`` prints one table per target of issue 24, each with femmech and
+the tool a user would run instead on the same matrices in the same process (min / median
+of ``--repeats`` interleaved runs per side, the ratio of the minima, the error of each side,
+a verdict against the target, and an idle baseline before and after; benchmarks/peers.py):
+
+- ``t1_eigensolve``: ``fm.modes(model, 20)`` (Sturm-checked) vs scipy ``eigsh`` with each
+  installed factorisation (peer_eigensolve.py);
+- ``t2_craig_bampton``: Craig-Bampton (n_b = 48, 30 modes + residual vectors) vs one full
+  20-mode eigensolve (peer_craig_bampton.py);
+- ``t3_interface``: interface reduction of ~1 000-DOF interfaces vs one full solve, with
+  the coupled-frequency error against plain Craig-Bampton (peer_interface.py);
+- ``t4_sweep``: the reduced coupled sweep per angle, tracked, vs bare LAPACK generalized
+  eigensolves of the same pencils (peer_sweep.py);
+- ``t5_monodromy``: a stability-chart point (monodromy with error control) vs
+  ``solve_ivp`` DOP853 at the same accuracy of the spectral radius (peer_monodromy.py);
+- ``t6_end_to_end``: reduction + 360-angle coupled sweep + error estimate vs 360 full
+  coupled ARPACK solves (peer_end_to_end.py);
+- ``t7_exudyn``: Craig-Bampton vs Exudyn's Hurty-Craig-Bampton (peer_exudyn.py).
+
+The ``issue10`` suite keeps the older entries below.
 
 Runs the entries below one after the other in this process, prints a table per entry and
 writes it to ``benchmarks/results/<name>.txt`` (atomically). Every table starts with the
@@ -11,7 +33,7 @@ same header: machine (CPU, cores, memory, load average at start and end of the e
 library versions (numpy, scipy, scikit-fem, femmech, MKL/PARDISO, scikit-sparse, exudyn)
 and the solver and thread settings (:mod:`femmech.solve.direct`, :mod:`femmech.solve.threads`).
 
-Entries (each reuses the ``main`` of a benchmark module in this folder):
+Entries of the ``issue10`` suite (each reuses the ``main`` of a benchmark module in this folder):
 
 - ``assembly``: ``build_model`` split into element matrices, COO → CSR, Tᵀ K T, and its
   ratio to one 20-mode eigensolve of the same frame (frame_modes.py);
@@ -296,7 +318,28 @@ def entry_scale(size):
     return scale.format_report(row, header=False) + [""], [row]
 
 
-ENTRIES = {
+PEER_TARGETS = {  # issue 24: one table per target, femmech beside the peer a user would run
+    "t1_eigensolve": "peer_eigensolve",
+    "t2_craig_bampton": "peer_craig_bampton",
+    "t3_interface": "peer_interface",
+    "t4_sweep": "peer_sweep",
+    "t5_monodromy": "peer_monodromy",
+    "t6_end_to_end": "peer_end_to_end",
+    "t7_exudyn": "peer_exudyn",
+}
+REPEATS = 3  # min / median of this many runs per side (--repeats)
+
+
+def _peer_entry(module_name: str):
+    def entry(size):
+        return _sibling(module_name).main(size, repeats=REPEATS)
+    entry.__name__ = f"entry_{module_name}"
+    return entry
+
+
+PEERS = {name: _peer_entry(module) for name, module in PEER_TARGETS.items()}
+
+ISSUE10 = {
     "assembly": entry_assembly,
     "eigensolve": entry_eigensolve,
     "craig_bampton": entry_craig_bampton,
@@ -305,6 +348,8 @@ ENTRIES = {
     "exudyn_hcb": entry_exudyn_hcb,
     "scale": entry_scale,
 }
+SUITES = {"peers": PEERS, "issue10": ISSUE10}
+ENTRIES = {**PEERS, **ISSUE10}
 
 
 # --- runner ---------------------------------------------------------------------------
@@ -339,11 +384,19 @@ def run_entry(name: str, size: str, blas_threads: int | None = None) -> Result:
 
 
 def main(size: str = "small", only=None, out_dir=RESULTS, echo=True,
-         blas_threads: int | None = None) -> dict[str, Result]:
-    """Run the suite (``only``: subset of ENTRIES) at ``size``; write one file per entry."""
+         blas_threads: int | None = None, suite: str = "peers",
+         repeats: int = REPEATS) -> dict[str, Result]:
+    """Run ``suite`` (``only``: any subset of ENTRIES instead) at ``size``, each peer side
+    ``repeats`` times; write one file per entry."""
+    global REPEATS
     if size not in SIZES:
         raise ValueError(f"unknown size {size!r}; choose from {list(SIZES)}")
-    names = list(ENTRIES) if not only else list(only)
+    if suite not in SUITES:
+        raise ValueError(f"unknown suite {suite!r}; choose from {list(SUITES)}")
+    if repeats < 1:
+        raise ValueError(f"repeats must be >= 1, got {repeats}")
+    REPEATS = repeats
+    names = list(SUITES[suite]) if not only else list(only)
     unknown = [n for n in names if n not in ENTRIES]
     if unknown:
         raise ValueError(f"unknown benchmarks {unknown}; choose from {list(ENTRIES)}")
@@ -365,14 +418,20 @@ def main(size: str = "small", only=None, out_dir=RESULTS, echo=True,
 
 def _cli(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--suite", choices=tuple(SUITES), default="peers",
+                        help="peers: issue 24's seven targets (default); issue10: the"
+                        " older entries")
     parser.add_argument("--size", choices=SIZES, default="small")
+    parser.add_argument("--repeats", type=int, default=REPEATS,
+                        help="runs per side of each peer comparison (min / median)")
     parser.add_argument("--only", nargs="+", metavar="NAME", choices=list(ENTRIES),
                         help=f"run only these entries ({', '.join(ENTRIES)})")
     parser.add_argument("--out", type=Path, default=RESULTS, help="folder of the table files")
     parser.add_argument("--blas-threads", type=int, default=None,
                         help="limit every BLAS/OpenMP library to N threads for the whole run")
     args = parser.parse_args(argv)
-    results = main(args.size, args.only, args.out, blas_threads=args.blas_threads)
+    results = main(args.size, args.only, args.out, blas_threads=args.blas_threads,
+                   suite=args.suite, repeats=args.repeats)
     failed = [name for name, r in results.items() if r.error]
     if failed:
         print(f"failed: {', '.join(failed)}", file=sys.stderr)

@@ -1,4 +1,5 @@
-"""Smoke test of the benchmark suite (benchmarks/run.py) at size tiny: no timing assertions."""
+"""Smoke test of the issue-10 benchmark suite (benchmarks/run.py --suite issue10) at size
+tiny: no timing assertions. The peer suite (issue 24) is tests/test_benchmarks_peers.py."""
 
 import importlib.util
 import math
@@ -28,7 +29,7 @@ def suite():
 @pytest.fixture(scope="module")
 def tiny(suite, tmp_path_factory):
     out = tmp_path_factory.mktemp("results")
-    return suite.main("tiny", out_dir=out, echo=False), out
+    return suite.main("tiny", out_dir=out, echo=False, suite="issue10"), out
 
 
 def _numbers(value):
@@ -48,7 +49,7 @@ def _numbers(value):
 
 def test_every_entry_runs_and_writes_a_table_with_the_header(suite, tiny):
     results, out = tiny
-    assert list(results) == list(suite.ENTRIES)
+    assert list(results) == list(suite.ISSUE10)
     for name, result in results.items():
         assert result.error is None, f"{name}: {result.error}"
         text = (out / f"{name}.txt").read_text()

@@ -336,6 +336,9 @@ class _BlockLanczos:
                 Q, MQ, R, b = self.step(SQ, j0, m)
                 H[m:m + b, j0:m] = R
                 H[j0:m, m:m + b] = R.T
+                if m < min(k, krylov) and b == block:  # fewer Ritz pairs than wanted:
+                    Q, MQ, m, j0 = self.extend(Q, MQ, m)  # no Rayleigh-Ritz yet
+                    continue
                 theta, Y, est = self.ritz(m, j0, b, R)
                 if far_check and m >= 2 * k + 2 * block:  # once: is σ far from the wanted?
                     far_check = False
@@ -351,6 +354,14 @@ class _BlockLanczos:
                     self.V[:, m:m + b], self.MV[:, m:m + b] = Q, MQ
                 j0, m = m, m + b
         return theta, Y, m
+
+    def extend(self, Q, MQ, m):
+        """Append the full block Q (when no Ritz pair can have converged yet: the basis
+        holds fewer than k vectors); returns (Q, MQ, m, j0) for the next step."""
+        b = Q.shape[1]
+        if not np.may_share_memory(Q, self.V):
+            self.V[:, m:m + b], self.MV[:, m:m + b] = Q, MQ
+        return Q, MQ, m + b, m
 
     def step(self, SQ, j0, m):
         """The next block Q from SQ = S V[:, j0:m], M-orthonormal to the basis: locally
@@ -408,10 +419,9 @@ class _BlockLanczos:
         block, H, omega, omega_prev = self.block, self.H, self.omega, self.omega_prev
         new = np.zeros_like(omega)
         if j:  # V_iᵀ M V_{j+1} for i < j
-            diag = np.stack([H[i * block:(i + 1) * block, i * block:(i + 1) * block]
-                             for i in range(j)])
-            down = np.stack([H[(i + 1) * block:(i + 2) * block,
-                               i * block:(i + 1) * block] for i in range(j)])
+            i = np.arange(j)  # the diagonal and subdiagonal blocks of H, (j, b, b) each
+            diag = H[:j * block, :j * block].reshape(j, block, j, block)[i, :, i, :]
+            down = H[block:(j + 1) * block, :j * block].reshape(j, block, j, block)[i, :, i, :]
             up = np.concatenate([np.zeros((1, block, block)), down[:-1]])
             below = np.concatenate([np.zeros((1, block, block)), omega[:j - 1]])
             est = (up @ below + diag @ omega[:j]
