@@ -38,7 +38,7 @@ from femmech.reduction.products import (
     symmetric_product,
 )
 from femmech.reduction.superelement import Superelement, interface_dofs
-from femmech.solve.eigen import solve_symmetric
+from femmech.solve.eigen import solve_symmetric, sturm_verified
 from femmech.solve.pencil import factorize
 
 CUTOFF_FACTOR = 2.0
@@ -47,6 +47,16 @@ interest (``f_max_hz``). With residual vectors (the default) the modes below f_m
 shipped machine frame are accurate to 1.4e-6; plain Craig-Bampton
 (``residual_vectors=False``) reaches only 1.4e-2 there and needs about 6 f_max for 0.1 %
 (tests/test_reduction.py, benchmarks/reduction.py)."""
+
+LOW_MEMORY_DOFS = 500_000
+"""From this many interior DOFs, :func:`craig_bampton` (with ``n_modes``) frees the
+``K_ii`` factorisation before the Sturm check of the fixed-interface modes, so that two
+factorisations are never held at once, and the superelement keeps none
+(``interior_factor`` is None: error estimates factorise again when asked). Measured on a
+1 008 150-DOF MITC4 box with 4 interface nodes (30 modes + residual vectors): peak resident
+memory 8.5 GB with both factorisations alive (the count's factor of ``K_ii - cut M_ii``
+on top of the shift factor, 2.0-2.5 GB each), 7.1 GB with this order (the Lanczos basis
+of the fixed-interface modes is then the peak; the superelement afterwards 2.7 GB less)."""
 
 PIVOT_RTOL = 1e-11
 """A pivot of the ``K_ii`` factorisation below this fraction of its diagonal entry marks
@@ -113,22 +123,27 @@ def craig_bampton(model: FEModel, interface, n_modes: int | None = None,
 
 
 def _reduce(model: FEModel, interface, selection, method: str,
-            residual_vectors: bool = False) -> Superelement:
+            residual_vectors: bool = False, low_memory: bool | None = None) -> Superelement:
     dofs = interface_dofs(model, interface)
     b = np.searchsorted(model.free, dofs)
     interior = np.setdiff1d(np.arange(model.n_free), b)
     if interior.size == 0:
         raise ValueError("every free DOF is an interface DOF: nothing to reduce")
     K, M = model.K_free.tocsr(), model.M_free.tocsr()
-    Kii, Kib = K[interior][:, interior], K[interior][:, b]
-    Mii, Mib = M[interior][:, interior], M[interior][:, b]
+    Ki, Mi = K[interior], M[interior]  # (rows once: each is a copy of the model's size)
+    Kii, Kib, Mii, Mib = Ki[:, interior], Ki[:, b], Mi[:, interior], Mi[:, b]
+    del Ki, Mi
     timings = {}
     t0 = time.perf_counter()
     lu = _factorize_interior(Kii, model.free[interior])
     t1 = time.perf_counter()
     Psi = rows_contiguous(lu.solve(Kib.toarray(order="F")), scale=-1.0)
     t2 = time.perf_counter()
-    omega2, Phi = _fixed_interface_modes(Kii, Mii, selection, lu)
+    if low_memory is None:
+        low_memory = interior.size >= LOW_MEMORY_DOFS and selection is not None \
+            and selection[0] == "count" and selection[1] > 0
+    omega2, Phi = _fixed_interface_modes(Kii, Mii, selection, lu, check=not low_memory)
+    n_fixed = omega2.size
     n_residual = 0
     with product_phase(Psi.shape[0], Psi.shape[1] + Phi.shape[1]):
         if residual_vectors:
@@ -138,8 +153,14 @@ def _reduce(model: FEModel, interface, selection, method: str,
         t3 = time.perf_counter()
         Kr, Mr = _project(K[b][:, b], Kib, Mii, Mib, M[b][:, b], Psi, Phi, omega2)
     t4 = time.perf_counter()
+    if low_memory:  # the Sturm check of the fixed-interface modes, with K_ii's factor freed
+        lu = None
+        count, found = sturm_verified(Kii, Mii, omega2[:n_fixed])
+        if count != found:  # modes missed (a cluster): the full path with deflated restarts
+            return _reduce(model, interface, selection, method, residual_vectors, False)
+    t5 = time.perf_counter()
     timings.update(factorisation=t1 - t0, constraint_modes=t2 - t1,
-                   fixed_interface_modes=t3 - t2, projection=t4 - t3)
+                   fixed_interface_modes=t3 - t2 + t5 - t4, projection=t4 - t3)
     points = model.mesh.points[dofs // DOF_PER_NODE]
     return Superelement(Kr, Mr, method, dofs, points, omega2, Psi, Phi, b, interior,
                         model.T.tocsr(), timings, n_residual, lu)
@@ -167,7 +188,9 @@ def _factorize_interior(Kii, dofs):
     return lu
 
 
-def _fixed_interface_modes(Kii, Mii, selection, lu):
+def _fixed_interface_modes(Kii, Mii, selection, lu, check: bool = True):
+    """(ω², Φ) of the fixed-interface modes, with ``lu`` (K_ii) as the shift factor;
+    ``check=False`` leaves the Sturm check of a mode count to the caller."""
     n_i = Kii.shape[0]
     if selection is None or (selection[0] == "count" and selection[1] == 0):
         return np.empty(0), np.empty((n_i, 0))
@@ -175,7 +198,7 @@ def _fixed_interface_modes(Kii, Mii, selection, lu):
     if kind == "count":
         if value >= n_i:
             raise ValueError(f"n_modes={value} but the interior has only {n_i} DOFs")
-        result = solve_symmetric(Kii, Mii, n_modes=value, sigma=0.0, factor=lu)
+        result = solve_symmetric(Kii, Mii, n_modes=value, sigma=0.0, factor=lu, check=check)
     else:
         result = solve_symmetric(Kii, Mii, band=(0.0, (2 * np.pi * value) ** 2), sigma=0.0,
                                  factor=lu)
