@@ -19,6 +19,7 @@ Stage 5 (analysis): uses coupling and solve; nothing here writes files.
 
 from __future__ import annotations
 
+import functools
 import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -30,7 +31,7 @@ from scipy.optimize import linear_sum_assignment
 from femmech.coupling import CoupledSystem
 from femmech.html import Flag, html_summary
 from femmech.solve import threads
-from femmech.solve.dense import dense_symmetric
+from femmech.solve.dense import ALL_PAIRS_FRACTION, dense_symmetric
 
 SYMMETRY_RTOL = 1e-10
 """C(φ) counts as symmetric when ``max|C - Cᵀ| <= SYMMETRY_RTOL * max|C|``."""
@@ -293,8 +294,14 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
     if not 0 < n_modes < system.n:
         raise ValueError(f"n_modes must lie in 1..{system.n - 1}, got {n_modes}")
     extra = min(n_modes + max(2, n_modes // 2), system.n - (0 if damped else 1))
-    matrices = _angle_matrices(system, phi, Omega, Omega_dot, damped)
     with _solve_phase(blas_threads):
+        if not damped and (system.H is None or not len(system.H)):
+            try:
+                return _lean_loop(_angle_stacks(system, phi, Omega, Omega_dot), system.n, phi,
+                                  n_modes, extra, track, keep_vectors, frequency_weight)
+            except _NotLeanError:
+                pass  # e.g. C(φ) unsymmetric at some angle: the general path below
+        matrices = _angle_matrices(system, phi, Omega, Omega_dot, damped)
         return _sweep_loop(matrices, system.n, system.H, phi, n_modes, extra, damped, track,
                            keep_vectors, frequency_weight)
 
@@ -319,8 +326,22 @@ def _sweep_model(model, phi, Omega, Omega_dot, n_modes, damped, track, keep_vect
         raise ValueError(f"n_modes must be an integer in 1..{n}, got {n_modes}")
     extra = min(int(n_modes) + max(2, int(n_modes) // 2), n)
     with _solve_phase(blas_threads):
+        if not damped:
+            try:
+                return _lean_loop(_model_stacks(matrices, n), n, phi, int(n_modes), extra,
+                                  track, keep_vectors, frequency_weight)
+            except _NotLeanError:
+                pass  # e.g. C(φ) unsymmetric at some angle: the general path below
         return _sweep_loop(matrices, n, None, phi, int(n_modes), extra, damped, track,
                            keep_vectors, frequency_weight)
+
+
+def _model_stacks(matrices, n: int):
+    """``stack(a, b) -> (M, C, symmetric)`` of :func:`_lean_loop` from the per-angle
+    ``matrices(a)`` of :func:`_model_matrices` (which index stacks of all angles)."""
+    M, C = (matrices(slice(None))[k] for k in (0, 2))
+    symmetric = bool(np.array_equal(C, C.transpose(0, 2, 1)))
+    return lambda a, b: (M[a:b], C[a:b], symmetric)
 
 
 def _model_matrices(model, phi, Omega, Omega_dot, damped: bool):
@@ -404,6 +425,51 @@ def _angle_matrices(system: CoupledSystem, phi, Omega, Omega_dot, damped: bool):
     they touch (mounts may share coordinates) and added per angle with one indexed
     update to a copy of the constant part.
     """
+    n, where, parts = _angle_parts(system, phi, Omega, Omega_dot, damped)
+
+    def matrices(a):
+        out = [None] * 3
+        for k, (constant, values) in parts.items():
+            A = constant.copy()
+            A[where] += values[a]
+            out[k] = A.reshape(n, n)
+        return tuple(out)
+
+    return matrices
+
+
+def _angle_stacks(system: CoupledSystem, phi, Omega, Omega_dot):
+    """``stack(a, b) -> (M, C, symmetric)``: M, C (b - a, n, n), the matrices of
+    :func:`_angle_matrices` (bit-identical) at angles ``phi[a:b]``, assembled in one indexed
+    update per matrix, and whether every C(φ) is symmetric to the bit (then C is its own
+    symmetric part and needs no symmetry check).
+
+    Each matrix is stored transposed (the returned arrays are transposed views, each
+    matrix Fortran-contiguous), so that LAPACK reads them without a copy."""
+    n, where, parts = _angle_parts(system, phi, Omega, Omega_dot, False)
+    transposed = (where % n) * n + where // n  # where each touched entry's mirror lies
+    mirror = np.minimum(np.searchsorted(where, transposed), max(where.size - 1, 0))
+    constant, values = parts[2]
+    symmetric = bool(np.array_equal(constant, constant.reshape(n, n).T.ravel())
+                     and np.array_equal(where[mirror], transposed)
+                     and (values == values[:, mirror]).all())
+    constants = {k: parts[k][0].reshape(n, n).T.ravel() for k in (0, 2)}
+
+    def stack(a, b):
+        out = []
+        for k in (0, 2):
+            A = np.repeat(constants[k][None], b - a, axis=0)
+            A[:, transposed] += parts[k][1][a:b]
+            out.append(A.reshape(b - a, n, n).transpose(0, 2, 1))
+        return (*out, symmetric)
+
+    return stack
+
+
+def _angle_parts(system: CoupledSystem, phi, Omega, Omega_dot, damped: bool):
+    """``(n, where, parts)``: the flat indices ``where`` of the entries the mounts touch and,
+    per matrix k (0 M, 1 B if ``damped``, 2 C), its constant part (n², ) and the summed
+    mechanism values (n_angles, where.size) of all angles."""
     n, n_angles = system.n, phi.size
     blocks = system.mechanism_blocks(phi, Omega, Omega_dot)
     flat = [(idx[:, None] * n + idx).ravel() for idx in system.touched]
@@ -418,16 +484,7 @@ def _angle_matrices(system: CoupledSystem, phi, Omega, Omega_dot, damped: bool):
 
     parts = {k: (A.ravel(), summed(k)) for k, A in enumerate((system.M0, system.B0, system.K0))
              if damped or k != 1}
-
-    def matrices(a):
-        out = [None] * 3
-        for k, (constant, values) in parts.items():
-            A = constant.copy()
-            A[where] += values[a]
-            out[k] = A.reshape(n, n)
-        return tuple(out)
-
-    return matrices
+    return n, where, parts
 
 
 def _sweep_loop(matrices, n, H, phi, n_modes, extra, damped, track, keep_vectors,
@@ -468,6 +525,313 @@ def _sweep_loop(matrices, n, H, phi, n_modes, extra, damped, track, keep_vectors
     return Sweep(phi, freq, lam, ratio, vectors, mac_step, form)
 
 
+LEAN_CHUNK = 64
+"""Most angles per batch of the lean path (:func:`_lean_loop`): the matrices and the
+M-products of one batch are formed at once."""
+
+LEAN_BATCH_BYTES = 2 * 2**20
+"""A batch holds at most this many bytes per stack of matrices (fewer angles for large n,
+so that a batch's matrices stay in cache between the steps that pass over them)."""
+
+
+class _NotLeanError(Exception):
+    """An angle needs the general path of :func:`_sweep_loop` (C(φ) not symmetric,
+    ``C - σM`` not positive definite, infinite eigenvalues, no mass)."""
+
+
+def _lean_loop(stack, n, phi, n_modes, extra, track, keep_vectors, weight) -> Sweep:
+    """:func:`_sweep_loop` for undamped, unconstrained, symmetric sweeps, batched.
+
+    ``stack(a, b) -> (M, C, symmetric)`` gives the matrices (b - a, n, n) of angles a..b-1
+    and whether all C are symmetric to the bit (:func:`_angle_stacks`). Per batch
+    of angles the shifts, scales, LAPACK inputs and M-products are formed at once and the
+    solves call LAPACK directly (:func:`_lean_solve`: the calls of
+    :func:`~femmech.solve.dense.dense_symmetric`, bit-identical eigenpairs); only the
+    assignment is per angle. A batch grows from 1 angle to :data:`LEAN_CHUNK` and starts
+    anew where a cluster is cut (the candidates are then doubled, as in
+    :func:`_sweep_loop`); the first angle is solved by :func:`frozen_modes` itself
+    (:func:`_first_angle`). Raises :class:`_NotLeanError` if an angle needs the general
+    path.
+    """
+    n_angles, limit = phi.size, n - 1
+    out = {"lam": np.zeros((n_angles, n_modes), dtype=complex),
+           "freq": np.zeros((n_angles, n_modes)), "ratio": np.zeros((n_angles, n_modes)),
+           "mac": np.ones((n_angles, n_modes)),
+           "vectors": np.zeros((n_angles, n, n_modes)) if keep_vectors else None}
+    a, size, previous = 0, 1, None
+    while a < n_angles:
+        b = min(a + size, n_angles)
+        M, C, symmetric = stack(a, b)
+        lam, X, f, r = (_first_angle(M[0], C[0], extra) if b == 1
+                        else _lean_solve(M, C, extra, symmetric))
+        split = _splits(f)
+        if track and extra < limit:
+            cut = ~split[:, n_modes - 1:].any(axis=1)  # = cuts_cluster of each angle
+            if cut[0]:
+                extra, size = min(2 * extra, limit), 1
+                continue
+            if cut.any():
+                b = a + int(np.argmax(cut))
+                M, lam, X, f, r, split = (x[: b - a] for x in (M, lam, X, f, r, split))
+        if track:
+            previous = _track_batch(M, X, f, split, previous, (a, lam, r), n_modes, weight, out)
+        else:
+            _store(out, slice(a, b), np.arange(n_modes), lam, f, r, X, None)
+        a, size = b, min(2 * size, LEAN_CHUNK, max(4, LEAN_BATCH_BYTES // (8 * n * n)))
+    return Sweep(phi, out["freq"], out["lam"], out["ratio"], out["vectors"], out["mac"],
+                 "symmetric")
+
+
+def _first_angle(M, C, extra):
+    """The first angle by :func:`frozen_modes` itself, as a batch of one (the results of
+    :func:`_lean_solve`, bit-identical); raises :class:`_NotLeanError` where the general
+    path is needed."""
+    ev, f, r, V, form = frozen_modes(M, None, C, extra)
+    if form != "symmetric" or ev.size != min(extra, len(M)) or np.iscomplexobj(V):
+        raise _NotLeanError("the first angle needs the general path")
+    return ev[None], V[None], f[None], r[None]
+
+
+def _store(out, at, pick, lam, f, r, X, mac):
+    """Write candidates ``pick`` (p,) of λ, f, ratio (..., q) and X (..., n, q) as the
+    branches at angles ``at`` (an index or a slice), with their MAC step if not None."""
+    out["lam"][at], out["freq"][at], out["ratio"][at] = lam[..., pick], f[..., pick], r[..., pick]
+    if mac is not None:
+        out["mac"][at] = mac
+    if out["vectors"] is not None:
+        out["vectors"][at] = X[..., pick]
+
+
+def _track_batch(M, X, f, split, previous, values, n_modes, weight, out):
+    """Assign the candidates of a batch of angles to the branches (:func:`_assign`).
+
+    ``M`` (k, n, n), ``X`` (k, n, q) candidates, ``f`` (k, q) their frequencies (Hz,
+    ascending), ``split`` (k, q - 1) the gaps between clusters (:func:`_splits`),
+    ``previous`` the branches at the angle before the batch (``(V (n, p), f (p,))`` or
+    None), ``values = (first angle, λ (k, q), damping ratio (k, q))``. The terms of the
+    assignment at angles 1..k-1 are formed for the batch at once (:func:`_pair_terms`),
+    assuming that the branches occupy the same candidates (as a set) as at angle 0;
+    per angle remain the Hungarian assignment and, where the assumption fails, the
+    products of that pair (:func:`_assign`, as in :func:`_sweep_loop`). Returns
+    ``previous`` for the next batch.
+    """
+    a0, lam, r = values
+    k = len(f)
+    MX = M @ X
+    G = X.transpose(0, 2, 1) @ MX  # (k, q, q): candidates of each angle
+    picks, macs = np.empty((k, n_modes), dtype=int), np.ones((k, n_modes))
+    if previous is None:
+        picks[0] = np.arange(n_modes)
+    else:
+        Vp, fp = previous
+        Gp = Vp.T @ (M[0] @ Vp)
+        picks[0], macs[0] = _assign(Vp.T @ MX[0], Gp.diagonal(), G[0].diagonal(), Gp, G[0],
+                                    fp, f[0], _groups(split[0]) or None,
+                                    _multi(clusters(fp)), weight)
+    if k > 1:
+        rows = np.sort(picks[0])
+        sub, cost = _pair_terms(M, X, MX, G, f, split, rows, weight)
+        best, best_sub, greedy = _row_minima(sub, cost)
+        at = np.full(f.shape[1], -1)
+        at[rows] = np.arange(rows.size)  # position of a candidate among ``rows``
+        assumed = rows.tolist()
+        for i in range(1, k):
+            prev = picks[i - 1]
+            if sorted(prev.tolist()) == assumed and greedy[i - 1]:
+                picks[i], macs[i] = best[i - 1][at[prev]], best_sub[i - 1][at[prev]]
+            elif sorted(prev.tolist()) == assumed:  # as formed for the batch
+                picked, chosen = linear_sum_assignment(cost[i - 1][at[prev]])
+                picks[i], macs[i] = chosen, sub[i - 1][at[prev]][picked, chosen]
+            else:  # a branch moved to another candidate: this pair as in _sweep_loop
+                Vp = X[i - 1][:, prev]
+                Gp = Vp.T @ (M[i] @ Vp)
+                picks[i], macs[i] = _assign(Vp.T @ MX[i], Gp.diagonal(), G[i].diagonal(), Gp,
+                                            G[i], f[i - 1, prev], f[i], _groups(split[i]) or None,
+                                            _multi(clusters(f[i - 1, prev])), weight)
+    at = slice(a0, a0 + k)
+    for name, A in (("lam", lam), ("freq", f), ("ratio", r)):
+        out[name][at] = np.take_along_axis(A, picks, axis=1)
+    out["mac"][at] = macs
+    if out["vectors"] is not None:
+        out["vectors"][at] = np.take_along_axis(X, picks[:, None, :], axis=2)
+    return X[-1][:, picks[-1]], f[-1, picks[-1]]
+
+
+def _row_minima(sub, cost):
+    """Where the assignment is decided row by row: ``(best, best_sub, greedy)`` with
+    ``best`` (k, p) each row's cheapest column of ``cost`` (k, p, q), ``best_sub`` the
+    subspace MAC there, and ``greedy`` (k,) True where every row's minimum is strict and
+    the rows' minima lie in distinct columns: that assignment is then the unique optimum,
+    the one ``linear_sum_assignment`` returns."""
+    best = cost.argmin(axis=2)
+    two = np.partition(cost, 1, axis=2)[:, :, :2]
+    distinct = (np.diff(np.sort(best, axis=1), axis=1) != 0).all(axis=1)
+    greedy = (two[:, :, 0] < two[:, :, 1]).all(axis=1) & distinct
+    return best, np.take_along_axis(sub, best[:, :, None], axis=2)[:, :, 0], greedy
+
+
+def _pair_terms(M, X, MX, G, f, split, rows, weight):
+    """Subspace MAC and cost of :func:`_assign` for the k - 1 consecutive pairs of angles
+    of a batch, (k - 1, p, q) each, with the candidates ``rows`` (p, sorted) of the first
+    angle of each pair as the previous branches (in that order) and all candidates of the
+    second as the new ones. ``MX`` = M @ X and ``G`` = Xᵀ M X (k, q, q) of the batch."""
+    Xp = X[:-1][:, :, rows]  # (k-1, n, p)
+    S = Xp.transpose(0, 2, 1) @ MX[1:]
+    P = Xp.transpose(0, 2, 1) @ (M[1:] @ Xp)
+    n_prev, n_new = np.diagonal(P, axis1=1, axis2=2), np.diagonal(G[1:], axis1=1, axis2=2)
+    mac = np.abs(S) ** 2 / (n_prev[:, :, None] * n_new[:, None, :])
+    side = _batch_span_mac(S, n_prev, G[1:], _splits(f[1:]), mac)  # the new clusters
+    back = _batch_span_mac(S.transpose(0, 2, 1), n_new, P, _splits(f[:-1, rows]),
+                           mac.transpose(0, 2, 1))  # the previous branches' clusters
+    sub = np.maximum(side, back.transpose(0, 2, 1))
+    jump = weight * (np.abs(f[1:, None, :] - f[:-1, rows, None])
+                     / np.maximum(f[:-1, rows], 1e-12)[:, :, None])
+    return sub, 1.0 - sub + jump + 0.1 * (sub - mac)
+
+
+def _batch_span_mac(S, nx, G, split, mac):
+    """:func:`_span_mac` of many angles at once (k, p, q): the clusters of Y are runs of
+    ascending frequencies (``split`` (k, q - 1), :func:`_splits`); the Gram blocks of all
+    clusters of one size are decomposed in one batched ``eigh``."""
+    out = mac.copy()
+    k, q = split.shape[0], split.shape[1] + 1
+    bounds = np.ones((k, q + 1), dtype=bool)  # cluster starts, and the end of each row
+    bounds[:, 1:q] = split
+    where = np.flatnonzero(bounds)
+    row, col = np.divmod(where, q + 1)
+    sizes = np.diff(col)
+    run = (row[:-1] == row[1:]) & (sizes > 1)  # clusters of more than one member
+    all_rows = np.arange(S.shape[1])[None, :, None]
+    for size in np.unique(sizes[run]):
+        chosen = run & (sizes == size)
+        j, s = row[:-1][chosen], col[:-1][chosen]
+        idx = s[:, None] + np.arange(size)
+        w, U = np.linalg.eigh(G[j[:, None, None], idx[:, :, None], idx[:, None, :]])
+        w = np.where(w > 1e-12 * np.abs(w).max(axis=1, keepdims=True), w, np.inf)
+        T = S[j[:, None, None], all_rows, idx[:, None, :]] @ U
+        values = (np.abs(T) ** 2 / w[:, None, :]).sum(axis=2) / nx[j]
+        out[j[:, None, None], all_rows, idx[:, None, :]] = values[:, :, None]
+    return out
+
+
+def _groups(split_row) -> list[np.ndarray]:
+    """The clusters of more than one member of ascending frequencies whose gaps ``split_row``
+    (q - 1,) flags (:func:`_splits`); :func:`clusters` of them without the single ones."""
+    bounds = [0, *(np.flatnonzero(split_row) + 1).tolist(), split_row.size + 1]
+    return [np.arange(i, j) for i, j in zip(bounds[:-1], bounds[1:], strict=True) if j - i > 1]
+
+
+def _multi(groups):
+    """The groups of more than one member, or None if there are none."""
+    multi = [g for g in groups if g.size > 1]
+    return multi or None
+
+
+def _splits(f):
+    """(k, q - 1) bool: the gap between ascending frequencies j and j + 1 (Hz, (k, q))
+    separates two :func:`clusters` (same rule, all angles at once)."""
+    size = np.maximum(f[:, 1:], 1e-3 * np.maximum(np.abs(f).max(axis=1, initial=0.0),
+                                                   1e-300)[:, None])
+    return f[:, 1:] - f[:, :-1] > CLUSTER_RTOL * size
+
+
+def _lean_solve(M, C, extra, symmetric: bool = False):
+    """:func:`frozen_modes` (undamped, symmetric) of a batch of angles, bit-identical.
+
+    M, C (k, n, n); ``symmetric``: every C is symmetric to the bit (so that it is its own
+    symmetric part ``(C + Cᵀ)/2``, and the symmetry check passes). Returns λ (k, q) complex,
+    mass-normalised vectors (k, n, q), frequency (Hz) and damping ratio (k, q), ascending,
+    q = min(extra, n). The shift σ, the λ scale and the LAPACK inputs are formed for the
+    batch at once; the driver follows :data:`~femmech.solve.dense.ALL_PAIRS_FRACTION` as
+    in :func:`~femmech.solve.dense.dense_symmetric`. Raises :class:`_NotLeanError` where
+    the general path is needed (it then raises or falls back as before).
+    """
+    k, n = M.shape[:2]
+    K = C if symmetric else _symmetric_part(C)
+    dm, dk = np.diagonal(M, axis1=1, axis2=2), np.diagonal(K, axis1=1, axis2=2)
+    sigma, scale = _lean_shifts(dm, dk)
+    wanted = min(extra, n)
+    # LAPACK's inputs in Fortran order, C-contiguous stacks of the transposes: Mf[i].T is
+    # M[i] (a copy: LAPACK overwrites it), Af[i].T is K[i] - σ M[i] (K[i] = K[i]ᵀ)
+    Mt = M.transpose(0, 2, 1)
+    Mf = Mt.copy() if Mt.flags.c_contiguous else np.ascontiguousarray(Mt)
+    Af = np.multiply(Mf, sigma[:, None, None])
+    np.subtract(K.transpose(0, 2, 1), Af, out=Af)
+    mu, X = np.empty((k, wanted)), np.empty((k, n, wanted))
+    solve = _sygvd if wanted >= ALL_PAIRS_FRACTION * n else _sygvx
+    for i in range(k):
+        mu[i], X[i] = solve(Mf[i].T, Af[i].T, wanted)
+    if not (mu > 1e-12 * np.maximum(np.abs(mu).max(axis=1), 1e-300)[:, None]).all():
+        raise _NotLeanError("infinite eigenvalues (massless coordinates)")
+    omega2 = sigma[:, None] + 1.0 / mu
+    X = X / np.sqrt(mu)[:, None, :]
+    order = np.argsort(omega2, axis=1)
+    omega2 = np.take_along_axis(omega2, order, axis=1)
+    freq, ratio = _undamped(omega2, scale[:, None])
+    return (omega2.astype(complex), np.take_along_axis(X, order[:, None, :], axis=2), freq,
+            ratio)
+
+
+def _symmetric_part(C):
+    """``(C + Cᵀ)/2`` of each matrix of C (k, n, n); raises :class:`_NotLeanError` unless
+    every C is symmetric within :data:`SYMMETRY_RTOL` (the test of :func:`frozen_modes`)."""
+    k = len(C)
+    CT = C.transpose(0, 2, 1)
+    skew = C - CT
+    np.abs(skew, out=skew)
+    skew = skew.reshape(k, -1).max(axis=1)
+    if not (skew <= SYMMETRY_RTOL * np.maximum(np.abs(C).reshape(k, -1).max(axis=1),
+                                                1e-300)).all():
+        raise _NotLeanError("C(φ) not symmetric")
+    return 0.5 * (C + CT)
+
+
+def _lean_shifts(dm, dk):
+    """Shift σ (:func:`~femmech.solve.pencil.default_shift`) and λ scale
+    (:func:`_lambda_scale`) of each angle from the diagonals of M and K (k, n), the
+    medians of all angles at once where the coordinates with mass and stiffness agree."""
+    ok = (dm > 0) & (dk > 0)
+    if not (dm > 0).any(axis=1).all():
+        raise _NotLeanError("no mass")
+    if (ok == ok[0]).all():
+        typical = (np.median(dk[:, ok[0]] / dm[:, ok[0]], axis=1) if ok[0].any()
+                   else np.ones(len(dk)))
+    else:
+        typical = np.array([np.median(k[o] / m[o]) if o.any() else 1.0  # eigenvalue_scale
+                            for k, m, o in zip(dk, dm, ok, strict=True)])
+    ratio = np.divide(np.abs(dk), dm, out=np.full(dm.shape, -np.inf), where=dm > 0)
+    top = ratio.max(axis=1)
+    return -1e-6 * typical, np.where(top > 0, top, 1.0)
+
+
+def _sygvd(M, A, wanted):
+    """The ``wanted`` largest μ of ``M x = μ A x`` and their vectors by LAPACK ``sygvd``,
+    as :func:`~femmech.solve.dense.dense_symmetric` calls it (M, A overwritten)."""
+    mu, X, info = sla.lapack.dsygvd(M, A, uplo="L", overwrite_a=1, overwrite_b=1)
+    if info:
+        raise _NotLeanError(f"sygvd info {info}")
+    return mu[-wanted:], X[:, -wanted:]
+
+
+def _sygvx(M, A, wanted):
+    """As :func:`_sygvd` by ``sygvx`` (range 'I'), the call of ``scipy.linalg.eigh`` with
+    ``subset_by_index`` (same workspace, hence the same blocking and bits)."""
+    n = len(M)
+    mu, X, m, _, info = sla.lapack.dsygvx(M, A, uplo="L", jobz="V", range="I", il=n - wanted + 1,
+                                          iu=n, lwork=_sygvx_lwork(n), overwrite_a=1,
+                                          overwrite_b=1)
+    if info or m != wanted:
+        raise _NotLeanError(f"sygvx info {info}")
+    return mu[:m], X[:, :m]
+
+
+@functools.cache
+def _sygvx_lwork(n: int) -> int:
+    """Workspace of ``sygvx`` as ``scipy.linalg.eigh`` queries it."""
+    from scipy.linalg.lapack import _compute_lwork
+    return _compute_lwork(sla.get_lapack_funcs("sygvx_lwork", dtype=np.float64), n, uplo="L")
+
+
 def assign_branches(previous, V, f, groups, M, weight):
     """Columns of V continuing each previous branch (Hungarian assignment).
 
@@ -490,10 +854,22 @@ def assign_branches(previous, V, f, groups, M, weight):
     Z = np.concatenate((V_prev, V), axis=1)
     G = Z.conj().T @ (M @ Z)  # (p + q, p + q)
     norms = G.diagonal().real
-    S = G[:p, p:]
-    mac = np.abs(S) ** 2 / (norms[:p, None] * norms[p:])
-    sub = np.maximum(_span_mac(S, norms[:p], G[p:, p:], groups, mac),
-                     _span_mac(S.conj().T, norms[p:], G[:p, :p], clusters(f_prev), mac.T).T)
+    return _assign(G[:p, p:], norms[:p], norms[p:], G[:p, :p], G[p:, p:], f_prev, f,
+                   groups, clusters(f_prev), weight)
+
+
+def _assign(S, n_prev, n_new, G_prev, G_new, f_prev, f, groups, groups_prev, weight):
+    """:func:`assign_branches` from the M-products of the previous vectors (p) and the
+    candidates (q): ``S`` (p, q), their norms ``n_prev`` (p,), ``n_new`` (q,) and Gram
+    matrices ``G_prev`` (p, p), ``G_new`` (q, q); ``groups``, ``groups_prev``: the
+    :func:`clusters` of ``f`` and ``f_prev``, or None where all are single (then both
+    subspace MACs are the plain MAC and need not be formed). Returns ``(pick, mac)``."""
+    mac = np.abs(S) ** 2 / (n_prev[:, None] * n_new)
+    if groups is None and groups_prev is None:
+        sub = mac
+    else:
+        sub = np.maximum(_span_mac(S, n_prev, G_new, groups or (), mac),
+                         _span_mac(S.conj().T, n_new, G_prev, groups_prev or (), mac.T).T)
     jump = np.abs(f - f_prev[:, None]) / np.maximum(f_prev, 1e-12)[:, None]
     rows, pick = linear_sum_assignment(1.0 - sub + weight * jump + 0.1 * (sub - mac))
     return pick, sub[rows, pick]  # rows = 0..p-1 (p <= q: every branch is assigned)
