@@ -23,6 +23,8 @@ a verdict against the target, and an idle baseline before and after; benchmarks/
   ``solve_ivp`` DOP853 at the same accuracy of the spectral radius (peer_monodromy.py);
 - ``t6_end_to_end``: reduction + 360-angle coupled sweep + error estimate vs 360 full
   coupled ARPACK solves (peer_end_to_end.py);
+- ``t6_memory``: peak memory of reducing a ~1M-DOF MITC4 shell box, in a child process
+  (peer_memory.py; no peer: the 8 GB target is absolute);
 - ``t7_exudyn``: Craig-Bampton vs Exudyn's Hurty-Craig-Bampton (peer_exudyn.py).
 
 The ``issue10`` suite keeps the older entries below.
@@ -325,6 +327,7 @@ PEER_TARGETS = {  # issue 24: one table per target, femmech beside the peer a us
     "t4_sweep": "peer_sweep",
     "t5_monodromy": "peer_monodromy",
     "t6_end_to_end": "peer_end_to_end",
+    "t6_memory": "peer_memory",
     "t7_exudyn": "peer_exudyn",
 }
 REPEATS = 3  # min / median of this many runs per side (--repeats)
