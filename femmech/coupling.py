@@ -274,11 +274,12 @@ def frame_row(frame, node, direction) -> np.ndarray:
         return free_row
     se = frame
     row = np.zeros(se.n_reduced)
-    row[:se.n_interface] = free_row[se.free_interface]
+    n_b, V = se.n_boundary, se.interface_basis  # u_b = V η_c with a reduced interface
+    row[:n_b] = free_row[se.free_interface] if V is None else free_row[se.free_interface] @ V
     interior = free_row[se.free_interior]
     if np.any(interior):
-        row[:se.n_interface] += interior @ se.Psi
-        row[se.n_interface:] += interior @ se.Phi
+        row[:n_b] += interior @ se.Psi
+        row[n_b:] += interior @ se.Phi
     return row
 
 

@@ -4,7 +4,10 @@
   field, save/load) and :func:`interface_dofs`;
 * :mod:`.component_modes`: Guyan and Craig-Bampton reduction with residual vectors;
 * :mod:`.products`: the dense-block products of the reduction;
-* :mod:`.estimate`: the a-posteriori frequency error estimate of a reduction;
+* :mod:`.estimate`: the a-posteriori frequency error estimates of a reduction, of the
+  superelement's modes and of coupled quasi-modes over a sweep;
+* :mod:`.interface_modes`: Craig-Bampton with a reduced interface (mode traces,
+  attachment vectors, characteristic constraint modes) and its error estimate;
 * :mod:`.superelement_file`: the validated file format (writer and reader), with
   :mod:`.superelement_format` (fields, checksums, messages), :mod:`.superelement_archive`
   (zip members and ``.npy`` headers) and :mod:`.superelement_checks` (meta, shapes,
@@ -17,7 +20,13 @@ mechanisms, coupling or analyses.
 """
 
 from femmech.reduction.component_modes import CUTOFF_FACTOR, craig_bampton, guyan
-from femmech.reduction.estimate import frequency_error_estimates
+from femmech.reduction.estimate import (
+    CoupledErrorForms,
+    coupled_error_estimates,
+    coupled_error_forms,
+    frequency_error_estimates,
+)
+from femmech.reduction.interface_modes import interface_error_estimates, reduce_interface
 from femmech.reduction.substructures import Assembly, assemble_parts
 from femmech.reduction.superelement import FORMAT_VERSION, Superelement, interface_dofs
 
@@ -25,10 +34,15 @@ __all__ = [
     "CUTOFF_FACTOR",
     "FORMAT_VERSION",
     "Assembly",
+    "CoupledErrorForms",
     "Superelement",
     "assemble_parts",
+    "coupled_error_estimates",
+    "coupled_error_forms",
     "craig_bampton",
     "frequency_error_estimates",
     "guyan",
     "interface_dofs",
+    "interface_error_estimates",
+    "reduce_interface",
 ]

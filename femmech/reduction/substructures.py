@@ -103,6 +103,12 @@ def assemble_parts(parts, tol: float = 1e-9) -> Assembly:
     parts = tuple(parts)
     if not parts:
         raise ValueError("no parts to assemble")
+    for i, part in enumerate(parts):
+        if getattr(part, "interface_basis", None) is not None:
+            raise ValueError(f"part {i} has a reduced interface (interface modes, from"
+                             " reduce_interface): its interface DOFs are not kept, so it"
+                             " cannot be joined to other parts at coincident DOFs; reduce it"
+                             " with craig_bampton for an assembly")
     data = [_coordinates(p) for p in parts]
     owner = np.concatenate([np.full(len(d[2]), i) for i, d in enumerate(data)])
     points = np.vstack([d[2] for d in data])

@@ -58,6 +58,14 @@ class Superelement:
         and ``projection``.
     n_residual : int
         How many of the ``n_q`` modal coordinates are residual vectors (the last ones).
+    interface_basis : ndarray (n_b, n_c) or None
+        Reduced interface (:func:`femmech.reduction.interface_modes.reduce_interface`):
+        the interface DOFs are ``u_b = V η_c`` with the first n_c reduced coordinates
+        η_c (mode traces, attachment vectors, CC modes); ``Psi`` is then
+        Ψ V (n_i, n_c). None for Guyan and plain Craig-Bampton (η_c = u_b).
+    interface_factor : Factor or None
+        Factorisation of the whole free ``K - σM`` kept by ``reduce_interface`` for
+        :func:`~femmech.reduction.interface_modes.interface_error_estimates`.
     """
 
     K: np.ndarray
@@ -74,12 +82,15 @@ class Superelement:
     timings: dict = field(default_factory=dict)
     n_residual: int = 0
     interior_factor: object = field(default=None, compare=False, repr=False)
+    interface_basis: np.ndarray | None = field(default=None, compare=False, repr=False)
+    interface_factor: object = field(default=None, compare=False, repr=False)
 
     def __repr__(self) -> str:
         modal = f", {self.n_modal} modal" if self.n_modal else ""
         residual = f" ({self.n_residual} residual vectors)" if self.n_residual else ""
+        cc = "" if self.interface_basis is None else f" in {self.n_boundary} interface modes"
         return (f"Superelement({self.method}: {self.n_reduced} coordinates ="
-                f" {self.n_interface} interface DOFs{modal}{residual}; full model"
+                f" {self.n_interface} interface DOFs{cc}{modal}{residual}; full model"
                 f" {self.n_dof} DOFs)")
 
     def _repr_html_(self) -> str:
@@ -98,6 +109,13 @@ class Superelement:
         return len(self.interface_dofs)
 
     @property
+    def n_boundary(self) -> int:
+        """Number of reduced coordinates of the interface: n_c with a reduced interface
+        (:attr:`interface_basis`), else n_b."""
+        V = self.interface_basis
+        return self.n_interface if V is None else V.shape[1]
+
+    @property
     def n_modal(self) -> int:
         """Number of fixed-interface modes n_q."""
         return len(self.modal_omega2)
@@ -114,9 +132,11 @@ class Superelement:
 
     @property
     def kinds(self) -> np.ndarray:
-        """``"interface"``, ``"modal"`` or ``"residual"`` per reduced coordinate, (n_r,)."""
+        """``"interface"`` (``"interface mode"`` with a reduced interface), ``"modal"`` or
+        ``"residual"`` per reduced coordinate, (n_r,)."""
         n_fixed = self.n_modal - self.n_residual
-        return np.array(["interface"] * self.n_interface + ["modal"] * n_fixed
+        kind = "interface" if self.interface_basis is None else "interface mode"
+        return np.array([kind] * self.n_boundary + ["modal"] * n_fixed
                         + ["residual"] * self.n_residual)
 
     @property
@@ -135,9 +155,10 @@ class Superelement:
         if q.shape[0] != self.n_reduced:
             raise ValueError(f"reduced vector has {q.shape[0]} rows, the superelement"
                              f" has {self.n_reduced} coordinates")
-        qb, qm = q[:self.n_interface], q[self.n_interface:]
+        qb, qm = q[:self.n_boundary], q[self.n_boundary:]
         u = np.zeros((self.T.shape[1],) + q.shape[1:], dtype=q.dtype)
-        u[self.free_interface] = qb
+        V = self.interface_basis
+        u[self.free_interface] = qb if V is None else np.tensordot(V, qb, 1)
         u[self.free_interior] = np.tensordot(self.Psi, qb, 1) + np.tensordot(self.Phi, qm, 1)
         return u
 

@@ -77,6 +77,11 @@ def write(se, path) -> Path:
     Atomic: a temporary file in the target folder is renamed over ``path``; on any
     failure the temporary file is removed and an existing ``path`` is left unchanged.
     """
+    if getattr(se, "interface_basis", None) is not None:
+        raise ValueError("Superelement.save: a superelement with a reduced interface"
+                         " (interface_basis, method 'craig-bampton-cc') cannot be written in"
+                         f" format {FORMAT_VERSION}; save the plain Craig-Bampton one or"
+                         " reduce again")
     path = Path(path)
     T = se.T.tocsr()
     arrays = {name: np.ascontiguousarray(getattr(se, name), dtype=np.float64)
