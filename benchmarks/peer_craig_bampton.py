@@ -26,7 +26,8 @@ import femmech.reduction as reduction  # noqa: E402
 from femmech.solve import threads  # noqa: E402
 
 N_FULL, N_MODES, TARGET = 20, 30, 1.2
-CASES = {"tiny": ("1k",), "small": ("5k", "24k"), "medium": ("5k", "24k", "151k")}
+CASES = {"tiny": ("1k",), "small": ("5k", "24k"), "medium": ("5k", "24k", "151k"),
+         "large": ("5k", "24k", "151k")}
 
 
 def case_row(case: str, repeats: int) -> dict:

@@ -33,7 +33,8 @@ from femmech.solve.pencil import eigenvalue_scale  # noqa: E402
 N_MODES = 20
 TARGET = 1.0
 CASES = {"tiny": ("1k",), "small": ("5k", "24k"),
-         "medium": ("5k", "24k", "solid35k", "151k")}
+         "medium": ("5k", "24k", "solid35k", "151k"),
+         "large": ("5k", "24k", "solid35k", "151k")}
 
 
 def model_for(case: str) -> fm.FEModel:

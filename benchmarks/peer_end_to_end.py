@@ -53,7 +53,7 @@ from femmech.solve import direct, threads  # noqa: E402
 
 N_CAMS, F_MAX_HZ, N_ANGLES, N_MODES, SIGMA = 12, 400.0, 360, 20, 0.0
 TARGET_RATIO, TARGET_ERROR = 100.0, 1e-3
-SIZES = {"tiny": 2, "small": 128, "medium": 960}
+SIZES = {"tiny": 2, "small": 128, "medium": 960, "large": 960}
 
 
 def femmech_study(model, cams, guides, phi) -> dict:

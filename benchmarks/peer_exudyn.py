@@ -33,7 +33,8 @@ import femmech as fm  # noqa: E402
 from femmech.solve import threads  # noqa: E402
 
 TARGET = 10.0
-CASES = {"tiny": ("1k",), "small": ("24k",), "medium": ("24k", "151k")}
+CASES = {"tiny": ("1k",), "small": ("24k",), "medium": ("24k", "151k"),
+         "large": ("24k", "151k")}
 
 
 def case_row(case: str, repeats: int) -> dict:

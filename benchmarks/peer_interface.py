@@ -49,7 +49,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from craig_bampton import interface_nodes  # noqa: E402  (sibling benchmarks)
 from peers import baseline_line, frame, idle_baseline, interleaved, table, verdict  # noqa: E402
 
-SIZES = {"tiny": "1k", "small": "24k", "medium": "151k"}
+SIZES = {"tiny": "1k", "small": "24k", "medium": "151k", "large": "151k"}
 RATIO_TARGET = 3.0
 ERROR_TARGET = 1e-3
 MOUNT_NODES = (3, 40, 90, 150)  # positions along the rails (tiny: modulo the 45 nodes)

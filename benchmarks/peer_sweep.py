@@ -42,7 +42,8 @@ from femmech.solve import threads  # noqa: E402
 TARGET, N_MODES = 1.3, 6
 # size: (reduced sizes r, angles)
 CASES = {"tiny": ((20, 38), 24), "small": ((20, 38, 60, 76, 100), 360),
-         "medium": ((20, 38, 60, 76, 100), 360)}
+         "medium": ((20, 38, 60, 76, 100), 360),
+         "large": ((20, 38, 60, 76, 100), 360)}
 DRIVERS = ("gv", "gvd", "gvx")
 
 
