@@ -12,7 +12,6 @@ Run: ``python benchmarks/peer_craig_bampton.py [--size tiny|small|medium] [--rep
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -64,8 +63,4 @@ def main(size: str = "small", repeats: int = 3):
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--size", choices=tuple(CASES), default="small")
-    parser.add_argument("--repeats", type=int, default=3)
-    args = parser.parse_args()
-    print("\n".join(main(args.size, args.repeats)[0]))
+    peers.cli(main, CASES, __doc__)

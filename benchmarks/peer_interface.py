@@ -20,7 +20,7 @@ against the plain model, the reduction's own a-posteriori estimate of that error
 (``interface_error_estimates`` with ``attachment_loads``; max over the band) and the
 estimate / true error of the worst mode.
 
-Usage: ``python benchmarks/peer_interface.py [tiny|small|medium] [repeats]``.
+Usage: ``python benchmarks/peer_interface.py [--size tiny|small|medium] [--repeats 3]``.
 """
 
 from __future__ import annotations
@@ -47,7 +47,15 @@ from femmech.reduction.interface_modes import (
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from craig_bampton import interface_nodes  # noqa: E402  (sibling benchmarks)
-from peers import baseline_line, frame, idle_baseline, interleaved, table, verdict  # noqa: E402
+from peers import (  # noqa: E402
+    baseline_line,
+    cli,
+    frame,
+    idle_baseline,
+    interleaved,
+    table,
+    verdict,
+)
 
 SIZES = {"tiny": "1k", "small": "24k", "medium": "151k", "large": "151k"}
 RATIO_TARGET = 3.0
@@ -146,6 +154,4 @@ def main(size: str = "small", repeats: int = 3):
 
 
 if __name__ == "__main__":
-    args = sys.argv[1:]
-    out, _ = main(args[0] if args else "small", int(args[1]) if len(args) > 1 else 3)
-    print("\n".join(out))
+    cli(main, SIZES, __doc__)

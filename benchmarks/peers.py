@@ -14,6 +14,7 @@ Models: grid space frames of steel hollow beams (benchmarks/solvers.py) at ~5k, 
 
 from __future__ import annotations
 
+import argparse
 import gc
 import statistics
 import sys
@@ -144,3 +145,13 @@ def verdict(ratio: float, target: float, at_most: bool = True) -> str:
     """'met' / 'missed' for a ratio against its target (<= target, or >= if not at_most)."""
     ok = ratio <= target if at_most else ratio >= target
     return "met" if ok else "MISSED"
+
+
+def cli(main, sizes, doc: str) -> None:
+    """The command line of a peer benchmark module: ``--size`` (a key of ``sizes``) and
+    ``--repeats``; prints the table lines of ``main(size, repeats)``."""
+    parser = argparse.ArgumentParser(description=doc.split("\n")[0])
+    parser.add_argument("--size", choices=tuple(sizes), default="small")
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+    print("\n".join(main(args.size, args.repeats)[0]))

@@ -155,6 +155,7 @@ def header(name: str, size: str, load_start, blas_threads) -> list[str]:
         "FEMMECH_THREADS", "FEMMECH_SOLVER", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
         "MKL_NUM_THREADS") if k in os.environ) or "no thread/solver variables set"
     auto_large = direct.resolve("auto", direct.AUTO_MIN_SIZE)
+    auto_small = direct.resolve("auto", direct.AUTO_MIN_SIZE - 1)
     return [
         f"benchmark: {name} (suite size {size}), {datetime.datetime.now():%Y-%m-%d %H:%M}",
         f"machine: {cpu}, {cores} cores / {os.cpu_count()} CPUs ({usable} usable),"
@@ -168,7 +169,7 @@ def header(name: str, size: str, load_start, blas_threads) -> list[str]:
         f" {_version('scikit-sparse')}, exudyn {exudyn or 'not installed'}",
         f"solvers: installed {', '.join(direct.available())}; default"
         f" '{direct.default_solver()}' ('auto' takes {auto_large} from"
-        f" {direct.AUTO_MIN_SIZE:,} unknowns, SuperLU below); "
+        f" {direct.AUTO_MIN_SIZE:,} unknowns, {auto_small} below); "
         + "; ".join(f"{k}: {v}" for k, v in direct.versions().items()),
         threads.describe(),
         f"suite BLAS limit: {blas_threads or 'none (--blas-threads)'}; environment: {env}",
