@@ -10,31 +10,10 @@ is checked against code that does not share the new kernels.
 
 import numpy as np
 import scipy.linalg as sla
+from test_stability import _hill_2dof  # the 2-DOF Hill system with gyroscopic damping
 
 from femmech.analysis import magnus
 from femmech.analysis.floquet import monodromy, monodromy_record
-
-
-def _hill_2dof():
-    """Two coupled DOF with periodic mass and stiffness (period 2π/3), as in
-    tests/test_stability.py (gyroscopic damping)."""
-    w = 3.0
-
-    def M(t):
-        m = np.zeros((t.size, 2, 2))
-        m[:, 0, 0] = 1.0 + 0.3 * np.cos(w * t)
-        m[:, 1, 1] = 2.0
-        m[:, 0, 1] = m[:, 1, 0] = 0.2 * np.sin(w * t)
-        return m
-
-    def C(t):
-        c = np.zeros((t.size, 2, 2))
-        c[:, 0, 0] = 20.0 + 8.0 * np.cos(w * t)
-        c[:, 1, 1] = 35.0
-        c[:, 0, 1], c[:, 1, 0] = -5.0, -5.0 + 2.0 * np.sin(2 * w * t)
-        return c
-
-    return M, np.array([[0.2, 0.5], [-0.5, 0.1]]), C, 2 * np.pi / w
 
 
 def _stiff_hill():
