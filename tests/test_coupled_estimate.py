@@ -108,7 +108,10 @@ def test_estimate_against_dense_reference_all_modes(reduction):
         mac = mac_matrix(shapes, V, M)
         match = mac.argmax(axis=1)
         true = np.sqrt(s.eigenvalues[a].real / lam[match]) - 1.0
-        keep = (mac.max(axis=1) > 0.9) & (true > 1e-10)
+        # errors below 1e-8 are not resolved by the reference: dense eigh of the full
+        # pencil has relative eigenvalue errors ~eps λ_max/λ ~ 1e-10 for the lowest modes
+        # (a mode with a true "error" of 1.2e-10 gave estimate/true 7e-11 on 1 BLAS thread)
+        keep = (mac.max(axis=1) > 0.9) & (true > 1e-8)
         ratios.append(est[a][keep] / true[keep])
         errors.append(true[keep])
     ratios, errors = np.concatenate(ratios), np.concatenate(errors)
