@@ -122,14 +122,20 @@ def craig_bampton(model: FEModel, interface, n_modes: int | None = None,
                    residual_vectors=residual_vectors)
 
 
-def _reduce(model: FEModel, interface, selection, method: str,
-            residual_vectors: bool = False, low_memory: bool | None = None) -> Superelement:
+def _partition(model: FEModel, interface):
+    """(interface DOFs in the full model, their positions b among the free DOFs, the
+    interior positions, K_free and M_free as CSR); ValueError if nothing is interior."""
     dofs = interface_dofs(model, interface)
     b = np.searchsorted(model.free, dofs)
     interior = np.setdiff1d(np.arange(model.n_free), b)
     if interior.size == 0:
         raise ValueError("every free DOF is an interface DOF: nothing to reduce")
-    K, M = model.K_free.tocsr(), model.M_free.tocsr()
+    return dofs, b, interior, model.K_free.tocsr(), model.M_free.tocsr()
+
+
+def _reduce(model: FEModel, interface, selection, method: str,
+            residual_vectors: bool = False, low_memory: bool | None = None) -> Superelement:
+    dofs, b, interior, K, M = _partition(model, interface)
     Ki, Mi = K[interior], M[interior]  # (rows once: each is a copy of the model's size)
     Kii, Kib, Mii, Mib = Ki[:, interior], Ki[:, b], Mi[:, interior], Mi[:, b]
     del Ki, Mi

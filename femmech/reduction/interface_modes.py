@@ -68,10 +68,11 @@ from femmech.reduction.component_modes import (
     CUTOFF_FACTOR,
     _factorize_interior,
     _fixed_interface_modes,
+    _partition,
     _residual_vectors,
 )
 from femmech.reduction.products import rows_contiguous
-from femmech.reduction.superelement import Superelement, interface_dofs
+from femmech.reduction.superelement import Superelement
 from femmech.solve import threads
 from femmech.solve.eigen import solve_symmetric
 from femmech.solve.pencil import default_shift, factorize
@@ -162,9 +163,11 @@ def reduce_interface(model: FEModel, interface, n_modes: int | None = None,
     """
     selection, f_max = _selection(n_modes, cutoff_hz, f_max_hz)
     t0 = time.perf_counter()
-    parts = _partition(model, interface)
-    dofs, b, interior, K, M = parts
-    lu = _factorize_interior(K[interior][:, interior], model.free[interior])
+    dofs, b, interior, K, M = _partition(model, interface)
+    Ki, Mi = K[interior], M[interior]  # (rows once: each is a copy of the model's size)
+    Kii, Kib, Mii, Mib = Ki[:, interior], Ki[:, b], Mi[:, interior], Mi[:, b]
+    del Ki, Mi
+    lu = _factorize_interior(Kii, model.free[interior])
     sigma = default_shift(K, M)
     full = factorize((K - sigma * M).tocsc())
     t1 = time.perf_counter()
@@ -179,16 +182,15 @@ def reduce_interface(model: FEModel, interface, n_modes: int | None = None,
         W = characteristic_modes(K, M, b, interior, lu, full, want, seed=seed)[2]
     if W.shape[1] < b.size:
         traces = _traces(K, M, b, full, sigma, E, f_max if mode_traces else None)
-        W = _join(K, M, W, traces, b, interior, lu)
+        W = _join(K, M, W, traces, b, interior, Kib, lu)
     V = np.ascontiguousarray(W[b])
     t2 = time.perf_counter()
-    Kii, Mii = K[interior][:, interior], M[interior][:, interior]
     omega2, Phi = _fixed_interface_modes(Kii, Mii, selection, lu)
     Psi = rows_contiguous(W[interior])
     n_residual = 0
     with _phase(Psi.shape[1] + Phi.shape[1]):
         if residual_vectors:
-            MibV = (M[interior][:, b] @ sp.csr_matrix(V)).tocsr()  # rows next to b only
+            MibV = (Mib @ sp.csr_matrix(V)).tocsr()  # rows next to b only
             more_omega2, more_Phi = _residual_vectors(Kii, Mii, MibV, Psi, Phi, lu)
             omega2, Phi = np.concatenate([omega2, more_omega2]), np.hstack([Phi, more_Phi])
             n_residual = more_omega2.size
@@ -220,13 +222,13 @@ def _traces(K, M, b, full, sigma, E, f_max):
     return np.ascontiguousarray(np.hstack([X[b], Xa[b]]))
 
 
-def _join(K, M, W, traces, b, interior, lu):
+def _join(K, M, W, traces, b, interior, Kib, lu):
     """Images (n_free, k) of the union of span(W[b]) and the ``traces``, M_G-orthonormal
     with diagonal ``Wᵀ K W`` (Rayleigh-Ritz on the Guyan pencil)."""
     if traces.shape[1] == 0:
         return W
     with _phase(W.shape[1] + traces.shape[1]):
-        Wt = _image(traces, K.shape[0], b, interior, K[interior][:, b], lu)
+        Wt = _image(traces, K.shape[0], b, interior, Kib, lu)
         extra, _ = _m_orthonormal(Wt, M @ Wt, W, M @ W)
         W = np.hstack([W, extra])
         stiff = W.T @ (K @ W)
@@ -273,15 +275,6 @@ def _cc_request(cc_modes, f_max, n_b):
         raise ValueError(f"cc_modes must be an integer >= 0 or 'auto', got"
                          f" {cc_modes!r}")
     return ("count", min(int(cc_modes), n_b))
-
-
-def _partition(model, interface):
-    dofs = interface_dofs(model, interface)
-    b = np.searchsorted(model.free, dofs)
-    interior = np.setdiff1d(np.arange(model.n_free), b)
-    if interior.size == 0:
-        raise ValueError("every free DOF is an interface DOF: nothing to reduce")
-    return dofs, b, interior, model.K_free.tocsr(), model.M_free.tocsr()
 
 
 def _attachment_loads(model, dofs, attachments) -> np.ndarray:
