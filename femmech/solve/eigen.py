@@ -215,6 +215,14 @@ def sturm_verified(K, M, omega2: np.ndarray, scale: float | None = None) -> tupl
     below the cut; they agree when nothing was missed. For callers that free the
     shift-invert factorisation before the count, so that two factorisations are never
     held at once (:func:`femmech.reduction.component_modes.craig_bampton` on large models).
+
+    Parameters
+    ----------
+    K, M : sparse (n, n)
+    omega2 : ndarray (k,)
+        The eigenvalues found, rad²/s².
+    scale : float, optional
+        Typical eigenvalue magnitude, rad²/s² (default :func:`~.pencil.eigenvalue_scale`).
     """
     omega2 = np.sort(np.asarray(omega2, dtype=float))
     scale = eigenvalue_scale(K, M) if scale is None else float(scale)
