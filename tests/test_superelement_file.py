@@ -11,7 +11,6 @@ independently of :mod:`femmech.reduction.superelement_file`.
 
 from __future__ import annotations
 
-import dataclasses
 import importlib.util
 import json
 import struct
@@ -21,8 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import scipy.sparse as sp
-from numpy.testing import assert_array_equal
+from test_reduction import assert_same_superelement as assert_same
 
 from femmech.errors import FileFormatError
 from femmech.reduction.component_modes import guyan
@@ -49,21 +47,6 @@ def base(tmp_path_factory):
     """The fuzz run's original: Craig-Bampton, residual vectors, a rigid link in T."""
     folder = tmp_path_factory.mktemp("original")
     return fz.make_base(folder)[0]
-
-
-def assert_same(a: Superelement, b: Superelement):
-    for f in dataclasses.fields(Superelement):
-        if f.name == "interior_factor":
-            continue
-        x, y = getattr(a, f.name), getattr(b, f.name)
-        if sp.issparse(x):
-            assert x.shape == y.shape
-            assert (x != y).nnz == 0
-        elif isinstance(x, np.ndarray):
-            assert x.dtype == y.dtype, f.name
-            assert_array_equal(x, y)
-        else:
-            assert x == y, f.name
 
 
 def rejected(path: Path, *fields: str) -> str:

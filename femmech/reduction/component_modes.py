@@ -58,6 +58,14 @@ memory 8.5 GB with both factorisations alive (the count's factor of ``K_ii - cut
 on top of the shift factor, 2.0-2.5 GB each), 7.1 GB with this order (the Lanczos basis
 of the fixed-interface modes is then the peak; the superelement afterwards 2.7 GB less)."""
 
+KEEP_RESPONSE_BYTES = 256e6
+"""Craig-Bampton with residual vectors keeps the solved ``K_ii⁻¹ (M_ii Ψ + M_ib)``
+(n_i × n_b) on the superelement (``inertia_response``) up to this size in bytes, and never
+in the low-memory order (:data:`LOW_MEMORY_DOFS`): the coupled error estimate needs the
+same n_b solves again. Measured on the 150k-DOF frame of ``benchmarks/peer_end_to_end.py``
+(24 interface DOFs, 58 MB): the 24 solves cost 0.05-0.13 s of the 2.1-2.5 s study. An
+interface of 1 002 DOFs at 151k would need 1.2 GB and is not kept."""
+
 PIVOT_RTOL = 1e-11
 """A pivot of the ``K_ii`` factorisation below this fraction of its diagonal entry marks
 K_ii as singular. The zero pivot of an unrestrained interior comes out as round-off
@@ -151,9 +159,12 @@ def _reduce(model: FEModel, interface, selection, method: str,
     omega2, Phi = _fixed_interface_modes(Kii, Mii, selection, lu, check=not low_memory)
     n_fixed = omega2.size
     n_residual = 0
+    response = None
     with product_phase(Psi.shape[0], Psi.shape[1] + Phi.shape[1]):
         if residual_vectors:
-            more_omega2, more_Phi = _residual_vectors(Kii, Mii, Mib, Psi, Phi, lu)
+            keep = not low_memory and 8 * Psi.size <= KEEP_RESPONSE_BYTES
+            more_omega2, more_Phi, response = _residual_vectors(Kii, Mii, Mib, Psi, Phi, lu,
+                                                                keep)
             omega2, Phi = np.concatenate([omega2, more_omega2]), np.hstack([Phi, more_Phi])
             n_residual = more_omega2.size
         t3 = time.perf_counter()
@@ -169,7 +180,7 @@ def _reduce(model: FEModel, interface, selection, method: str,
                    fixed_interface_modes=t3 - t2 + t5 - t4, projection=t4 - t3)
     points = model.mesh.points[dofs // DOF_PER_NODE]
     return Superelement(Kr, Mr, method, dofs, points, omega2, Psi, Phi, b, interior,
-                        model.T.tocsr(), timings, n_residual, lu)
+                        model.T.tocsr(), timings, n_residual, lu, inertia_response=response)
 
 
 def _factorize_interior(Kii, dofs):
@@ -211,8 +222,9 @@ def _fixed_interface_modes(Kii, Mii, selection, lu, check: bool = True):
     return result.omega2, result.vectors
 
 
-def _residual_vectors(Kii, Mii, Mib, Psi, Phi, lu):
-    """Residual vectors, as K- and M-orthogonal pseudo-modes (ω², vectors) (n_i, <= n_b).
+def _residual_vectors(Kii, Mii, Mib, Psi, Phi, lu, keep: bool = False):
+    """Residual vectors, as K- and M-orthogonal pseudo-modes: (ω², vectors (n_i, <= n_b),
+    ``K_ii⁻¹ (M_ii Ψ + M_ib)`` (n_i, n_b) if ``keep`` else None).
 
     ``R = K_ii⁻¹ (M_ii Ψ + M_ib)`` minus its M-projection on Φ; a Rayleigh-Ritz solve
     in span(R) makes the vectors mutually K- and M-orthogonal (they are K-orthogonal to
@@ -224,6 +236,7 @@ def _residual_vectors(Kii, Mii, Mib, Psi, Phi, lu):
     of a frame in m-kg-s but 26 of the same frame in mm-t-s.
     """
     R = rows_contiguous(lu.solve(plus_sparse(Mii @ Psi, Mib)))
+    response = R.copy() if keep else None
     MR = Mii @ R
     scale = np.sqrt(np.einsum("ij,ij->j", R, MR))  # M-norms before removing Φ
     scale = 1.0 / np.where(scale > 0, scale, 1.0)
@@ -242,7 +255,7 @@ def _residual_vectors(Kii, Mii, Mib, Psi, Phi, lu):
     omega2, Z = np.linalg.eigh(0.5 * (stiff + stiff.T))
     # one n_i x n_b x n_b product (the Gram matrix); the others have the kept columns only
     # (an interface of 1 002 DOFs along rails kept 108)
-    return omega2, R @ Z
+    return omega2, R @ Z, response
 
 
 def _project(Kbb, Kib, Mii, Mib, Mbb, Psi, Phi, omega2):

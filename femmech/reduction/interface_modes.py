@@ -191,7 +191,7 @@ def reduce_interface(model: FEModel, interface, n_modes: int | None = None,
     with _phase(Psi.shape[1] + Phi.shape[1]):
         if residual_vectors:
             MibV = (Mib @ sp.csr_matrix(V)).tocsr()  # rows next to b only
-            more_omega2, more_Phi = _residual_vectors(Kii, Mii, MibV, Psi, Phi, lu)
+            more_omega2, more_Phi, _ = _residual_vectors(Kii, Mii, MibV, Psi, Phi, lu)
             omega2, Phi = np.concatenate([omega2, more_omega2]), np.hstack([Phi, more_Phi])
             n_residual = more_omega2.size
         t3 = time.perf_counter()

@@ -66,6 +66,12 @@ class Superelement:
     interface_factor : Factor or None
         Factorisation of the whole free ``K - σM`` kept by ``reduce_interface`` for
         :func:`~femmech.reduction.interface_modes.interface_error_estimates`.
+    inertia_response : ndarray (n_i, n_b) or None
+        ``K_ii⁻¹ (M_ii Ψ + M_ib)``, the interior's static response to the inertia forces
+        of unit interface accelerations: solved for the residual vectors and kept (up to
+        :data:`~femmech.reduction.component_modes.KEEP_RESPONSE_BYTES`) so that
+        :func:`~femmech.reduction.estimate.coupled_error_forms` does not solve it again.
+        Not saved to files.
     """
 
     K: np.ndarray
@@ -84,6 +90,7 @@ class Superelement:
     interior_factor: object = field(default=None, compare=False, repr=False)
     interface_basis: np.ndarray | None = field(default=None, compare=False, repr=False)
     interface_factor: object = field(default=None, compare=False, repr=False)
+    inertia_response: np.ndarray | None = field(default=None, compare=False, repr=False)
 
     def __repr__(self) -> str:
         modal = f", {self.n_modal} modal" if self.n_modal else ""
