@@ -24,7 +24,7 @@ import femmech as fm
 import femmech.fe.elements.shell as shell
 from femmech.fe import sections
 from femmech.fe.generators import grid_frame
-from femmech.solve import arpack, cholmod, direct, lanczos, pardiso, superlu
+from femmech.solve import arpack, cholmod, direct, eigen, lanczos, pardiso, superlu
 from femmech.solve.dense import dense_symmetric
 from femmech.solve.eigen import solve_symmetric
 from femmech.solve.pencil import default_shift, eigenvalue_scale, factorize
@@ -211,13 +211,26 @@ def test_shell_element_batches_do_not_change_the_matrices(monkeypatch):
         assert np.array_equal(M0, M1)
 
 
-def test_sturm_check_completes_a_cluster_of_twelve_cut_by_n_modes():
+PATHS = {"arpack-first": None, "block-lanczos": 0}
+"""The two paths of the lowest modes: ARPACK for exactly the wanted pairs on small models
+(eigen.ARPACK_BELOW), and the guarded block Lanczos of large ones (ARPACK_BELOW = 0)."""
+
+
+def _path(monkeypatch, path):
+    if PATHS[path] is not None:
+        monkeypatch.setattr(eigen, "ARPACK_BELOW", PATHS[path])
+
+
+@pytest.mark.parametrize("path", PATHS)
+def test_sturm_check_completes_a_cluster_of_twelve_cut_by_n_modes(monkeypatch, path):
     """Twelve equal oscillators (eigenvalue 1e4, 12-fold, like 12 equal cams) beside a
     1 000-mass spring chain, cut by ``n_modes``. Block Lanczos
     (block 2) sees only a few members of a repeated eigenvalue per run; the Sturm count
     must make the deflated runs find every member below the cut. A first version
     truncated the merged set back to ``n_modes`` before counting again and looped until
-    it gave up (12 cams of the textile shaft, 6 modes)."""
+    it gave up (12 cams of the textile shaft, 6 modes). ARPACK (single vector) sees one
+    member; the same count and deflated runs complete the set."""
+    _path(monkeypatch, path)
     n_chain, n_osc = 1000, 12
     k_chain = 4e7  # lowest chain eigenvalues ~99 j², ten of them below the cluster
     main = np.full(n_chain, 2 * k_chain)
@@ -245,13 +258,17 @@ def test_sturm_check_completes_a_cluster_of_twelve_cut_by_n_modes():
         assert result.residual.max() < 100 * EPS * lam[-1] / lam[0]
 
 
-def test_far_default_shift_is_moved_towards_the_wanted_eigenvalues():
+@pytest.mark.parametrize("path", PATHS)
+def test_far_default_shift_is_moved_towards_the_wanted_eigenvalues(monkeypatch, path):
     """A 500-mass chain (eigenvalues ~99 (2j - 1)² rad²/s²) beside 1 500 very stiff
     coordinates (1e13 N/m on 1 kg each, like stiff contacts): the default shift
     -1e-6 median(K_ii/M_ii) = -1e7 lies 1e5 times further below zero than λ_1 is above
     it, so θ = 1/(λ - σ) of the 20 wanted differ by 1 % only. The solver moves σ to
     -max(λ_1, 1e-3 |σ|) = -1e4 (lanczos.FAR_SHIFT) and factorises again; the result
-    equals the dense reference and passes the Sturm check."""
+    equals the dense reference and passes the Sturm check. (On the ARPACK-first path
+    ARPACK does not converge within ARPACK_MAXITER restarts there, and block Lanczos,
+    which moves the shift, takes over.)"""
+    _path(monkeypatch, path)
     n_chain, k_chain = 500, 1e7
     main = np.full(n_chain, 2 * k_chain)
     main[-1] = k_chain  # free end; fixed at the other
@@ -270,13 +287,67 @@ def test_far_default_shift_is_moved_towards_the_wanted_eigenvalues():
     assert_allclose(result.omega2, lam[:20], rtol=1e-10)
 
 
+def test_small_models_take_arpack_for_exactly_the_wanted_pairs(monkeypatch):
+    """Below ARPACK_BELOW the lowest modes come from one ARPACK run of n_modes +
+    ARPACK_GUARD pairs (no block Lanczos), Sturm-checked; the result equals the block-Lanczos
+    path's to round-off (both ~eps λ_max absolute, eigenvalue_atol)."""
+    model = tube_cantilever()  # 600 DOFs; pairs of double eigenvalues
+    K, M = model.K_free, model.M_free
+    calls = []
+    monkeypatch.setattr(lanczos, "_lowest_pairs", _counting(lanczos._lowest_pairs, calls))
+    monkeypatch.setattr(eigen, "_lowest_pairs", lanczos._lowest_pairs)
+    first = solve_symmetric(K, M, n_modes=5)  # the 5th is a double: the cluster comes back
+    assert calls == []  # ARPACK only
+    assert first.omega2.size == first.sturm_count == 6
+    monkeypatch.setattr(eigen, "ARPACK_BELOW", 0)
+    block = solve_symmetric(K, M, n_modes=5)
+    assert len(calls) == 1
+    assert_allclose(first.omega2, block.omega2, rtol=0, atol=eigenvalue_atol(K, M))
+
+
+def test_a_missed_double_member_is_found_by_the_count(monkeypatch):
+    """ARPACK_GUARD = 0 and 3 modes of the tube (pairs 1-2, 3-4): the count just above λ_3
+    shows 4 eigenvalues, a deflated run adds the 4th (the pair is not cut)."""
+    model = tube_cantilever()
+    K, M = model.K_free, model.M_free
+    monkeypatch.setattr(eigen, "ARPACK_GUARD", 0)
+    result = solve_symmetric(K, M, n_modes=3)
+    ref = dense_symmetric(K, M, 6)[0]
+    assert result.omega2.size == result.sturm_count == 4
+    assert_allclose(result.omega2, ref[:4], rtol=0, atol=eigenvalue_atol(K, M))
+
+
+def test_without_a_count_the_guarded_path_runs(monkeypatch):
+    """Where the Sturm count is not available (a factorisation that pivoted off the
+    diagonal), the ARPACK-first result (no guards) is replaced by the guarded block
+    Lanczos, whose guards see a cut cluster."""
+    model = tube_cantilever()
+    K, M = model.K_free, model.M_free
+    monkeypatch.setattr(eigen, "inertia_below", lambda *args, **kw: None)
+    calls = []
+    monkeypatch.setattr(eigen, "_lowest_pairs", _counting(lanczos._lowest_pairs, calls))
+    result = solve_symmetric(K, M, n_modes=3)
+    assert len(calls) == 1
+    assert result.sturm_count is None
+    assert result.omega2.size == 4  # the guards completed the pair
+
+
+def _counting(func, calls):
+    def wrapped(*args, **kwargs):
+        calls.append(args[2])
+        return func(*args, **kwargs)
+    return wrapped
+
+
 def test_arpack_takes_over_where_block_lanczos_does_not_converge(pencil, monkeypatch):
     """With no solves allowed (MAX_SOLVES_PER_MODE = -1e9) block Lanczos gives up at
     once; solve_symmetric warns and ARPACK returns the same modes (dense reference,
-    round-off of the shift-inverted pencil)."""
+    round-off of the shift-inverted pencil). (ARPACK_BELOW = 0: the block-Lanczos path,
+    which small models otherwise skip.)"""
     K, M, _, _, _ = pencil
     expected = dense_symmetric(K, M, 8)[0]
     monkeypatch.setattr(lanczos, "MAX_SOLVES_PER_MODE", -10**9)
+    monkeypatch.setattr(eigen, "ARPACK_BELOW", 0)
     with pytest.warns(fm.FemmechWarning, match="falling back to ARPACK"):
         result = solve_symmetric(K, M, n_modes=8, dense_below=0)
     assert result.sturm_count == result.omega2.size >= 8

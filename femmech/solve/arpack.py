@@ -16,7 +16,7 @@ from femmech.solve import threads
 from femmech.solve.pencil import _n_mass
 
 
-def _arpack(K, M, k, sigma, lu, deflate=None):
+def _arpack(K, M, k, sigma, lu, deflate=None, maxiter=None):
     """``k`` eigenpairs nearest ``sigma`` by shift-invert Lanczos (ARPACK).
 
     ``deflate`` (n, m), M-orthonormal eigenvectors already found, is projected out of the
@@ -28,6 +28,8 @@ def _arpack(K, M, k, sigma, lu, deflate=None):
     with mass (a singular M: massless DOFs), less the deflated vectors; ARPACK's
     basis size ``ncv`` (and k below it) is capped there, where the default
     ``max(2k + 1, 20)`` made ARPACK stop with "could not build an Arnoldi factorization".
+    ``maxiter``: ARPACK's cap on restarts (default scipy's, 10 n); beyond it
+    ``scipy.sparse.linalg.ArpackNoConvergence`` is raised.
     """
     n = K.shape[0]
     krylov = _n_mass(M) - (0 if deflate is None else deflate.shape[1])
@@ -49,7 +51,7 @@ def _arpack(K, M, k, sigma, lu, deflate=None):
     op = spla.LinearOperator((n, n), matvec=solve, dtype=float)
     with threads.solve_phase():  # a loop of solves: 1 BLAS thread (femmech.solve.threads)
         omega2, X = spla.eigsh(sp.csr_matrix(K), k=k, M=sp.csr_matrix(M), sigma=sigma,
-                               which="LM", OPinv=op, v0=v0, ncv=ncv)
+                               which="LM", OPinv=op, v0=v0, ncv=ncv, maxiter=maxiter)
     if krylov + (0 if deflate is None else deflate.shape[1]) < n:
         X = _purify(X, omega2, sigma, M, solve)
     order = np.argsort(omega2)

@@ -7,8 +7,9 @@ K may be singular (free-free structures): the shift σ is chosen below zero so t
 
 This module is the driver (:func:`solve_symmetric`, its result :class:`EigenResult`): it
 checks the request, takes the dense path (:mod:`.dense`) for small systems and otherwise
-one of the sparse paths, the lowest modes (block Lanczos, :mod:`.lanczos`), a band from
-zero, or a band (ARPACK, :mod:`.arpack`), all verified by Sturm counts (:mod:`.sturm`);
+one of the sparse paths, the lowest modes (ARPACK, :mod:`.arpack`, below
+:data:`ARPACK_BELOW` DOFs, else block Lanczos, :mod:`.lanczos`), a band from zero, or a
+band (ARPACK), all verified by Sturm counts (:mod:`.sturm`);
 it normalises the modes and checks their residuals (:mod:`.residuals`).
 
 Stage 1, solve (linear algebra): imports only :mod:`femmech.errors` and other
@@ -21,6 +22,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.sparse.linalg import ArpackNoConvergence
 
 from femmech.errors import FemmechWarning
 from femmech.solve import direct
@@ -41,6 +43,32 @@ MAX_DEFLATIONS = 10
 
 DENSE_BELOW = 400
 """Systems with fewer DOFs than this are solved with dense LAPACK (``scipy.linalg.eigh``)."""
+
+ARPACK_BELOW = 30_000
+"""Below this many DOFs, :func:`_sparse_lowest` with the Sturm check runs ARPACK for the
+wanted pairs and :data:`ARPACK_GUARD` more, instead of block Lanczos with
+``max(4, n/5)`` guard pairs: the count just above the last wanted eigenvalue shows
+whether a member of a repeated eigenvalue is missing, and deflated block-Lanczos runs add
+it, so fewer guards are needed. ARPACK's Fortran loop costs less per step than the Python
+block-Lanczos loop where a solve is cheap. Measured (``fm.modes(model, 20)``, check
+included, min of 4-7 interleaved runs in one process; benchmarks/peer_eigensolve.py
+models): 5k-DOF frame 27.3 ms against 36.3 ms (block Lanczos), 24k frame 229 ms against
+244 ms, but 35k P2-tetrahedron solid 4.53 s against 3.77 s and 151k frame 2.51 s against
+2.08 s (expensive solves: block Lanczos solves two right-hand sides at once and needs
+fewer of them)."""
+
+ARPACK_GUARD = 1
+"""Pairs beyond the wanted ones in that ARPACK run. A repeated last wanted eigenvalue
+(the 20th of the symmetric 24k frame is double) is then found in the same run: with none
+the count found it missing and a deflated run took the 20-mode solve from 229 ms to
+367 ms. ARPACK's cost is not monotonic in k (restarts): on the 5k frame 26.3, 27.3, 36.6
+and 33.7 ms for 0, 1, 2 and 3 guards; on the 24k frame 367, 229, 210, 218 ms."""
+
+ARPACK_MAXITER = 10
+"""Restarts allowed to that ARPACK run; without convergence the block-Lanczos path takes
+over (it also moves a shift far below the wanted eigenvalues,
+:data:`~.lanczos.FAR_SHIFT`). 20 modes of the 5k frame took 2-3 restarts with
+σ/λ₁ = -0.05 … -5, 4 with σ/λ₁ = -50 and 11 with -500."""
 
 RIGID_TOL = 1e-12
 """Eigenvalues with ``|ω²| <= RIGID_TOL * scale`` are rigid-body modes (scale: a typical
@@ -63,8 +91,9 @@ class EigenResult:
         positive.
     method : str
         ``"dense"`` (LAPACK) or ``"arpack"``: sparse shift-invert Lanczos (the lowest
-        modes by femmech's block Lanczos, :func:`~.lanczos._block_lanczos`; bands by
-        ARPACK; the name is kept for the results and tests that select on it).
+        modes by ARPACK below :data:`ARPACK_BELOW` DOFs, else by femmech's block Lanczos,
+        :func:`~.lanczos._block_lanczos`; bands by ARPACK; the name is kept for the
+        results and tests that select on it).
     sigma : float
         Shift used, rad²/s².
     residual : ndarray (n_modes,)
@@ -263,22 +292,18 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
         if factor is None else factor
     guard = max(4, n_modes // 5)
     limit = min(n - 2, _n_mass(M) - 1)  # below the Krylov dimension (and ARPACK's k < n - 1)
-    while True:
-        k = min(n_modes + guard, limit)
-        if k < n_modes:
-            raise ValueError(f"{n_modes} modes of a {n}-DOF system with {_n_mass(M)} DOFs with"
-                             " mass: use the dense path (raise dense_below) or ask for fewer"
-                             " modes")
+    found = None
+    if check and n < ARPACK_BELOW and n_modes + ARPACK_GUARD <= limit:
         try:
-            omega2, X = _lowest_pairs(K, M, k, sigma, lu, n_wanted=n_modes, far_check=movable)
-        except _FarShiftError as far:
-            sigma, movable = far.shift, False  # (the same ordering: no new analysis)
-            lu = lu.factorize_like(K - sigma * M, definite=None if sigma < 0 else False)
-            continue
+            found = _arpack(K, M, n_modes + ARPACK_GUARD, sigma, lu, maxiter=ARPACK_MAXITER)
+        except ArpackNoConvergence:
+            found = None  # (a shift far from the wanted eigenvalues): block Lanczos
+    if found is not None:
+        omega2, X = found
         count = _complete_cluster(omega2, n_modes)
-        if count < k or k == limit:
-            break
-        guard *= 2  # a cluster of repeated eigenvalues fills all computed modes
+    else:
+        omega2, X, count, sigma, lu, guard = _guarded_lanczos(K, M, n_modes, sigma, lu,
+                                                              movable, guard, limit)
     if not check:
         return omega2[:count], X[:, :count], None, None, sigma
     for _ in range(MAX_DEFLATIONS):
@@ -288,6 +313,11 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
         cut = _cut_above(omega2[count - 1], scale)
         inside = int(np.count_nonzero(omega2 <= cut))
         below = inertia_below(K, M, cut, like=lu)
+        if below is None and found is not None:  # no count: the guards must see a cluster
+            found = None
+            omega2, X, count, sigma, lu, guard = _guarded_lanczos(K, M, n_modes, sigma, lu,
+                                                                  movable, guard, limit)
+            cut = _cut_above(omega2[count - 1], scale)
         if below is None:
             return omega2[:count], X[:, :count], None, cut, sigma
         if below == inside:
@@ -303,6 +333,30 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
         count = _complete_cluster(omega2, min(n_modes, omega2.size))
     raise RuntimeError(f"Sturm check: eigenvalues below {cut:.6g} rad²/s² still missing after"
                        f" {MAX_DEFLATIONS} deflated restarts; try another sigma")
+
+
+def _guarded_lanczos(K, M, n_modes, sigma, lu, movable, guard, limit):
+    """The ``n_modes`` lowest pairs by block Lanczos with ``guard`` more (doubled while a
+    cluster fills all computed ones), moving a far default shift (``movable``). Returns
+    ``omega2, X, count`` (the wanted ones and the rest of a cut cluster), ``sigma``, the
+    factor ``lu`` of ``K - σM`` and the last guard."""
+    n = K.shape[0]
+    while True:
+        k = min(n_modes + guard, limit)
+        if k < n_modes:
+            raise ValueError(f"{n_modes} modes of a {n}-DOF system with {_n_mass(M)} DOFs with"
+                             " mass: use the dense path (raise dense_below) or ask for fewer"
+                             " modes")
+        try:
+            omega2, X = _lowest_pairs(K, M, k, sigma, lu, n_wanted=n_modes, far_check=movable)
+        except _FarShiftError as far:
+            sigma, movable = far.shift, False  # (the same ordering: no new analysis)
+            lu = lu.factorize_like(K - sigma * M, definite=None if sigma < 0 else False)
+            continue
+        count = _complete_cluster(omega2, n_modes)
+        if count < k or k == limit:
+            return omega2, X, count, sigma, lu, guard
+        guard *= 2  # a cluster of repeated eigenvalues fills all computed modes
 
 
 def _sparse_from_zero(K, M, hi, sigma, check, scale, movable):
