@@ -352,3 +352,23 @@ def test_arpack_takes_over_where_block_lanczos_does_not_converge(pencil, monkeyp
         result = solve_symmetric(K, M, n_modes=8, dense_below=0)
     assert result.sturm_count == result.omega2.size >= 8
     assert_allclose(result.omega2[:8], expected, rtol=1e-9)
+
+
+@pytest.mark.parametrize("path", PATHS)
+def test_band_from_zero_with_a_given_factor_is_found_as_the_lowest_modes(monkeypatch, path):
+    """A band (0, hi) with a factor of K at σ = 0 (the fixed-interface modes of a
+    Craig-Bampton cutoff) is solved as the n lowest modes, n from the Sturm count below
+    hi, with that factor (no new shift factorisation): every eigenvalue below hi, checked
+    by the count, equal to the dense reference (both round-off, eigenvalue_atol)."""
+    _path(monkeypatch, path)
+    model = frame()
+    K, M = model.K_free, model.M_free
+    ref = dense_symmetric(K, M, 20)[0]
+    hi = 0.5 * (ref[11] + ref[12])
+    lu = factorize(K, solver="superlu")
+    made = []
+    monkeypatch.setattr(eigen, "factorize", lambda *a, **kw: made.append(a) or factorize(*a, **kw))
+    result = solve_symmetric(K, M, band=(0.0, hi), sigma=0.0, factor=lu)
+    assert made == []  # the given factor served the shift
+    assert result.omega2.size == result.sturm_count == 12
+    assert_allclose(result.omega2, ref[:12], rtol=0, atol=eigenvalue_atol(K, M))
