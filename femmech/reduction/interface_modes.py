@@ -208,9 +208,10 @@ def reduce_interface(model: FEModel, interface, n_modes: int | None = None,
 def _traces(K, M, b, full, sigma, E, f_max):
     """Interface traces (n_b, k) of the attachment responses ``K⁻¹ [E; 0]`` (whose traces
     are ``S⁻¹ E``) and, for ``f_max`` given, of the component's eigenvectors below
-    ``TRACE_FACTOR * f_max`` (:func:`~femmech.solve.eigen.solve_symmetric`, shift-invert
-    with the factorisation of ``K - σM``: ARPACK needs fewer solves than a block Krylov
-    space for these few modes; a block version took 240 solves for 17 modes)."""
+    ``TRACE_FACTOR * f_max`` (:func:`~femmech.solve.eigen.solve_symmetric`: a band from
+    zero, found as the lowest modes by shift-invert Lanczos with the factorisation of
+    ``K - σM`` and Sturm-checked; a block Krylov space of the traces' own took 240 solves
+    for 17 modes)."""
     n_free = K.shape[0]
     G = np.zeros((n_free, E.shape[1]))
     G[b] = E
