@@ -369,9 +369,10 @@ def _sparse_from_zero(K, M, hi, sigma, check, scale, movable, factor=None):
     a given ``factor`` of ``K - σM`` (σ <= 0: the ``K_ii`` of a Craig-Bampton reduction at
     σ = 0), and Sturm-checked there (the count reuses the ordering of the factorisation of
     ``K - σM``). Returns ``omega2, X, sturm_count, cut, sigma``. (With a factor this path
-    replaced ARPACK at the band centre's shift for the fixed-interface modes up to 176 Hz
-    of the 150k-DOF rails frame of benchmarks/peer_interface.py, 25 modes: 2.2 s against
-    2.7-3.1 s with block Lanczos, the same eigenvalues to 3.4e-15.)
+    replaced ARPACK at the given shift (:func:`_sparse_band`) for the fixed-interface modes
+    up to 176 Hz of the 150k-DOF rails frame of benchmarks/peer_interface.py, 25 modes:
+    2.2 s with block Lanczos against 2.7-3.1 s with ARPACK, the same eigenvalues to
+    3.4e-15.)
     """
     lu = factorize(K - sigma * M, definite=None if sigma < 0 else False) \
         if factor is None else factor
