@@ -141,12 +141,17 @@ def _partition(model: FEModel, interface):
     return dofs, b, interior, model.K_free.tocsr(), model.M_free.tocsr()
 
 
+def _interior_blocks(K, M, interior, b):
+    """(K_ii, K_ib, M_ii, M_ib) as CSR, the interior rows sliced once (each slice of rows
+    is a copy of the model's size)."""
+    Ki, Mi = K[interior], M[interior]
+    return Ki[:, interior], Ki[:, b], Mi[:, interior], Mi[:, b]
+
+
 def _reduce(model: FEModel, interface, selection, method: str,
             residual_vectors: bool = False, low_memory: bool | None = None) -> Superelement:
     dofs, b, interior, K, M = _partition(model, interface)
-    Ki, Mi = K[interior], M[interior]  # (rows once: each is a copy of the model's size)
-    Kii, Kib, Mii, Mib = Ki[:, interior], Ki[:, b], Mi[:, interior], Mi[:, b]
-    del Ki, Mi
+    Kii, Kib, Mii, Mib = _interior_blocks(K, M, interior, b)
     timings = {}
     t0 = time.perf_counter()
     lu = _factorize_interior(Kii, model.free[interior])

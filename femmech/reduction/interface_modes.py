@@ -68,6 +68,7 @@ from femmech.reduction.component_modes import (
     CUTOFF_FACTOR,
     _factorize_interior,
     _fixed_interface_modes,
+    _interior_blocks,
     _partition,
     _residual_vectors,
 )
@@ -164,9 +165,7 @@ def reduce_interface(model: FEModel, interface, n_modes: int | None = None,
     selection, f_max = _selection(n_modes, cutoff_hz, f_max_hz)
     t0 = time.perf_counter()
     dofs, b, interior, K, M = _partition(model, interface)
-    Ki, Mi = K[interior], M[interior]  # (rows once: each is a copy of the model's size)
-    Kii, Kib, Mii, Mib = Ki[:, interior], Ki[:, b], Mi[:, interior], Mi[:, b]
-    del Ki, Mi
+    Kii, Kib, Mii, Mib = _interior_blocks(K, M, interior, b)
     lu = _factorize_interior(Kii, model.free[interior])
     sigma = default_shift(K, M)
     full = factorize((K - sigma * M).tocsc())

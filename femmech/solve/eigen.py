@@ -293,16 +293,15 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
         if factor is None else factor
     guard = max(4, n_modes // 5)
     limit = min(n - 2, _n_mass(M) - 1)  # below the Krylov dimension (and ARPACK's k < n - 1)
-    found = None
+    guarded = True  # block Lanczos with guard pairs; False: ARPACK, the count guards
     if check and n < ARPACK_BELOW and n_modes + ARPACK_GUARD <= limit:
         try:
-            found = _arpack(K, M, n_modes + ARPACK_GUARD, sigma, lu, maxiter=ARPACK_MAXITER)
+            omega2, X = _arpack(K, M, n_modes + ARPACK_GUARD, sigma, lu,
+                                maxiter=ARPACK_MAXITER)
+            count, guarded = _complete_cluster(omega2, n_modes), False
         except ArpackNoConvergence:
-            found = None  # (a shift far from the wanted eigenvalues): block Lanczos
-    if found is not None:
-        omega2, X = found
-        count = _complete_cluster(omega2, n_modes)
-    else:
+            pass  # (a shift far from the wanted eigenvalues): block Lanczos
+    if guarded:
         omega2, X, count, sigma, lu, guard = _guarded_lanczos(K, M, n_modes, sigma, lu,
                                                               movable, guard, limit)
     if not check:
@@ -314,8 +313,8 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
         cut = _cut_above(omega2[count - 1], scale)
         inside = int(np.count_nonzero(omega2 <= cut))
         below = inertia_below(K, M, cut, like=lu)
-        if below is None and found is not None:  # no count: the guards must see a cluster
-            found = None
+        if below is None and not guarded:  # no count: the guards must see a cluster
+            guarded = True
             omega2, X, count, sigma, lu, guard = _guarded_lanczos(K, M, n_modes, sigma, lu,
                                                                   movable, guard, limit)
             cut = _cut_above(omega2[count - 1], scale)
