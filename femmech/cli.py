@@ -17,7 +17,8 @@ Exit codes (:data:`EXIT_CODES`):
 ====  ===================================================================================
 
 Errors are one line on stderr, no traceback unless ``--debug``. Suspicious inputs
-(nearly coincident nodes, loose parts, unit mix-ups: :mod:`femmech.fe.checks`) are reported,
+(nearly coincident nodes, loose parts, unit mix-ups: :mod:`femmech.fe.checks`; what a mesh
+file holds that the model will not have: :func:`femmech.fe.mesh_io.read_mesh`) are reported,
 not refused: one ``warning:`` line each on stdout and in the run's log.
 
 Scene files are data: ``run`` executes Python code a scene names (``module =``) only with
@@ -33,10 +34,11 @@ import argparse
 import logging
 import sys
 import traceback
+import warnings
 from contextlib import contextmanager
 from pathlib import Path
 
-from femmech.errors import InputError, NumericalError
+from femmech.errors import InputError, ModelWarning, NumericalError
 
 OK, INTERNAL, USAGE, INPUT, NUMERICAL, FILESYSTEM, INTERRUPTED = 0, 1, 2, 3, 4, 5, 130
 EXIT_CODES = {OK: "success", INTERNAL: "internal error (a bug: rerun with --debug, report it)",
@@ -99,7 +101,9 @@ def _check(args) -> int:
     from femmech.scene.load import load_scene
 
     path = args.scene
-    prepared = prepare(load_scene(path), code_root=args.code_root, run_code=False)
+    with warnings.catch_warnings(record=True) as caught:  # read_mesh: what a file loses
+        warnings.simplefilter("always", ModelWarning)
+        prepared = prepare(load_scene(path), code_root=args.code_root, run_code=False)
     scene = prepared.scene
     parts = ", ".join(f"{n} ({m.n_nodes} nodes)" for n, m in prepared.meshes.items())
     analyses = [k for k in ("modes", "sweep", "stability", "response", "check", "drive_event")
@@ -111,6 +115,11 @@ def _check(args) -> int:
         print(f"{path.name}: note: [{spec.where}] module {Path(spec.module).name}: user code,"
               " not executed (check never runs it; its coordinate names are unchecked;"
               " 'femmech run --allow-code' runs it)")
+    for w in caught:
+        if issubclass(w.category, ModelWarning):
+            print(f"{path.name}: warning: {_one_line(w.message)}")
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     for line in finding_lines(prepared):  # suspicious inputs: reported, not refused
         print(f"{path.name}: {line}")
     return OK

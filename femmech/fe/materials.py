@@ -10,6 +10,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
+MODULUS_RANGE = (1e-100, 1e100)
+"""Range of E and G accepted, in the unit of the model (Pa, N/mm², psi, ...): every real
+material of every unit system lies far inside (soft gels: 1e2 Pa; diamond: 1.2e12 Pa).
+Outside, the element matrices (E or G times section and length factors) leave the normal
+floats: a 2 m steel cantilever of E = 5e-324 (subnormal) has NaN matrices ("the mass
+matrix has no positive diagonal entry"), E = 1e-310 stops LAPACK, E = 1e300 overflows;
+E = 1e-300 still solves. 1e±100 leaves 200 orders for the other factors."""
+DENSITY_RANGE = (1e-100, 1e100)
+"""Range of a non-zero density ρ accepted (kg/m³, t/mm³, ...; ρ = 0 is a massless
+material): a 2 m steel cantilever of ρ = 1e-300 overflows in the eigenvalues (E/ρ),
+ρ = 1e-290 still solves."""
+
 
 def check_real(value, label: str) -> None:
     """TypeError naming ``label`` unless ``value`` is a real number (not a bool, string or
@@ -59,12 +71,18 @@ class Material:
             raise ValueError(
                 f"material {self.name!r}: rho must be non-negative and finite, got {self.rho}"
             )
+        _in_range(self.E, MODULUS_RANGE, f"material {self.name!r}: E", "MODULUS_RANGE")
+        if self.rho:
+            _in_range(self.rho, DENSITY_RANGE, f"material {self.name!r}: rho",
+                      "DENSITY_RANGE")
         if (self.nu is None) == (self.G is None):
             raise ValueError(f"material {self.name!r}: give exactly one of nu and G")
         if self.nu is not None and not -1.0 < self.nu < 0.5:
             raise ValueError(f"material {self.name!r}: nu must lie in (-1, 0.5), got {self.nu}")
         if self.G is not None and not (np.isfinite(self.G) and self.G > 0):
             raise ValueError(f"material {self.name!r}: G must be positive and finite, got {self.G}")
+        if self.G is not None:
+            _in_range(self.G, MODULUS_RANGE, f"material {self.name!r}: G", "MODULUS_RANGE")
 
     @property
     def shear_modulus(self) -> float:
@@ -79,6 +97,14 @@ class Material:
         if self.nu is not None:
             return float(self.nu)
         return self.E / (2.0 * self.G) - 1.0
+
+
+def _in_range(value: float, bounds: tuple, label: str, limit: str) -> None:
+    low, high = bounds
+    if not low <= value <= high:
+        raise ValueError(f"{label} = {value!r} is outside [{low:g}, {high:g}] ({limit}): the"
+                         " element matrices would not be finite normal numbers; no unit"
+                         " system has such a material")
 
 
 STEEL = Material(E=210e9, nu=0.3, rho=7850.0, name="steel")

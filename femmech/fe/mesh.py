@@ -30,6 +30,12 @@ larger count is refused before it is allocated (:func:`femmech.fe.mesh_io.read_m
 :mod:`femmech.fe.generators`)."""
 MAX_CELLS = 20_000_000
 """Most cells (elements) of a mesh read from a file or generated for a scene."""
+MAX_COORDINATE = 1e30
+"""Largest coordinate magnitude of a node (m, or the length unit of the model). No mesh
+in any unit system spans 1e30 units; far beyond, the element matrices overflow (their
+terms hold the third and higher powers of the lengths: a 2 m cantilever with its section
+scaled by 1e70 overflows, coordinates of 1e120 overflow ``L**3``) and squared distances
+overflow at 1.3e154, each with numpy overflow warnings instead of an error."""
 
 
 @dataclass(frozen=True)
@@ -49,8 +55,8 @@ class Mesh:
     Raises
     ------
     ValueError
-        Non-finite coordinates, cells referencing missing nodes, or groups referencing
-        missing cells, each naming the offending item.
+        Coordinates non-finite or beyond :data:`MAX_COORDINATE`, cells referencing
+        missing nodes, or groups referencing missing cells, each naming the offending item.
     TypeError
         Coordinates that are not real numbers, connectivity or group indices that are not
         integers, or containers of the wrong kind, naming the item.
@@ -71,9 +77,7 @@ class Mesh:
             raise ValueError(f"points must have shape (n_nodes, 3), got {points.shape}")
         if points.shape[1] == 2:
             points = np.column_stack([points, np.zeros(len(points))])
-        bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
-        if bad.size:
-            raise ValueError(f"node {bad[0]} has non-finite coordinates {points[bad[0]]}")
+        check_coordinates(points)
         object.__setattr__(self, "points", points)
         object.__setattr__(self, "cells", {k: _check_cells(k, v, len(points))
                                            for k, v in self.cells.items()})
@@ -196,6 +200,51 @@ class Mesh:
                 if name in self.node_sets else "")
         return (f"unknown {what} {name!r}; the mesh has cell sets {name_list(self.cell_sets)}"
                 f"{did_you_mean(name, self.cell_sets)}{note}")
+
+
+def check_coordinates(points: np.ndarray, ids=None, what: str = "node") -> None:
+    """ValueError naming the first node (``what`` and its number in ``ids``, else its
+    index) whose coordinates are not finite or exceed :data:`MAX_COORDINATE` in
+    magnitude, and how many such nodes there are; computes no squares (no overflow)."""
+    points = np.asarray(points, dtype=float)
+    if not points.size:
+        return
+    with np.errstate(invalid="ignore"):
+        size = np.abs(points).max(axis=1)
+    bad = np.flatnonzero(~(size <= MAX_COORDINATE))  # NaN compares False
+    if bad.size:
+        k = int(bad[0])
+        name = f"{what} {ids[k]}" if ids is not None else f"{what} {k}"
+        if not np.isfinite(points[k]).all():
+            raise ValueError(f"{name} has non-finite coordinates {points[k].tolist()}"
+                             f" ({bad.size} nodes with non-finite or too large ones)")
+        raise ValueError(f"{name} has coordinates {points[k].tolist()} beyond"
+                         f" ±{MAX_COORDINATE:g} (MAX_COORDINATE: the element matrices would"
+                         f" overflow; {bad.size} such nodes)")
+
+
+def repeated_cells(cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Cells on the node set of an earlier cell (same nodes in any order).
+
+    Parameters
+    ----------
+    cells : ndarray (n_cells, nodes_per_cell) of int
+
+    Returns
+    -------
+    repeats : ndarray (n_repeats,) of int
+        Indices of the cells whose nodes an earlier cell has, ascending.
+    originals : ndarray (n_repeats,) of int
+        For each, the index of the first cell on those nodes.
+    """
+    cells = np.asarray(cells)
+    if len(cells) < 2:
+        return np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
+    key = np.sort(cells, axis=1)
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    original = first[inverse.ravel()]
+    repeats = np.flatnonzero(original != np.arange(len(cells)))
+    return repeats, original[repeats]
 
 
 def merged_node_index(points: np.ndarray, tol: float, keep=()) -> np.ndarray:

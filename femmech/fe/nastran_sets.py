@@ -32,9 +32,11 @@ from femmech.fe.mesh_sets import MAX_SET_MEMBERS, MAX_SETS
 SET_CARDS = ("SET1", "SET3", "SPC1")
 
 
-def add_sets(path, raw) -> None:
+def add_sets(path, raw, grid_sets=None) -> None:
     """Add the ``SET1``, ``SET3`` and ``SPC1`` sets of the bulk data in ``path`` to the
-    meshio mesh ``raw`` (as ``point_sets`` and per-block ``cell_sets``), in place."""
+    meshio mesh ``raw`` (as ``point_sets`` and per-block ``cell_sets``), in place, and
+    the node sets ``grid_sets`` {name: GRID numbers} (the GRIDs' PS constraints,
+    :attr:`femmech.fe.nastran_cards.Census.ps_sets`)."""
     cp = raw.point_data.get("nastran:ref")
     if cp is not None and np.any(np.asarray(cp) != 0):
         cp = np.asarray(cp)
@@ -53,6 +55,8 @@ def add_sets(path, raw) -> None:
         raise FileFormatError("some elements have no property ID (PID field blank); give"
                               " every element its PID")
     nodes, cells, total = {}, {}, [0]
+    for name, numbers in (grid_sets or {}).items():
+        nodes[name] = [grids.indices(numbers, f"GRID field PS ({name})")]
     for card, fields, line in bulk_cards(path, SET_CARDS):
         label = f"{card} (line {line})"
         if len(nodes) + len(cells) > MAX_SETS:
@@ -85,9 +89,11 @@ def add_sets(path, raw) -> None:
                                - start[k] for k in range(len(sizes))]
 
 
-def bulk_cards(path, wanted=SET_CARDS):
-    """``(card name, data fields, line number)`` of each bulk data card named in ``wanted``,
-    continuation lines joined; fields are stripped strings, blank ones ``""``."""
+def bulk_cards(path, wanted=SET_CARDS, raw_names: bool = False):
+    """``(card name, data fields, line number)`` of each bulk data card named in ``wanted``
+    (None: every card), continuation lines joined; fields are stripped strings, blank ones
+    ``""``. Names are upper case without a large-field ``*``, or with ``raw_names`` as
+    written (as meshio reads them: ``CBAR*`` and ``cbar`` are no ``CBAR`` to meshio)."""
     card, fields, first, in_bulk = None, [], 0, False
     with open(path, encoding="utf-8", errors="replace") as f:
         for lineno, line in enumerate(f, 1):
@@ -99,19 +105,20 @@ def bulk_cards(path, wanted=SET_CARDS):
                 continue
             if line.upper().startswith("ENDDATA"):
                 break
-            name, data = _split(line)
+            name, data = _split(line, raw_names)
             if name is None:  # a continuation line
                 if card is not None:
                     fields += data
                 continue
             if card is not None:
                 yield card, fields, first
-            card, fields, first = (name, data, lineno) if name in wanted else (None, [], 0)
+            keep = wanted is None or name in wanted
+            card, fields, first = (name, data, lineno) if keep else (None, [], 0)
     if card is not None:
         yield card, fields, first
 
 
-def _split(line: str) -> tuple[str | None, list[str]]:
+def _split(line: str, raw: bool = False) -> tuple[str | None, list[str]]:
     """Card name (None for a continuation line) and the data fields 2-9 of one line."""
     head = line.split(",", 1)[0] if "," in line else line[:8]
     is_continuation = head[:1] in ("+", "*") or not head.strip()
@@ -125,7 +132,7 @@ def _split(line: str) -> tuple[str | None, list[str]]:
     data = [d.strip() for d in data]
     if is_continuation:
         return None, data
-    return head.strip().rstrip("*").upper(), data
+    return (head.strip() if raw else head.strip().rstrip("*").upper()), data
 
 
 def _skip_skin(items: list[str]) -> list[str]:
@@ -134,9 +141,13 @@ def _skip_skin(items: list[str]) -> list[str]:
 
 def _integer(text: str, label: str, what: str) -> int:
     try:
-        return int(text)
+        value = int(text)
     except ValueError:
         raise FileFormatError(f"{label}: {what} must be an integer, got {text[:20]!r}") from None
+    if not -2**63 <= value < 2**63:  # numpy would raise OverflowError, naming nothing
+        raise FileFormatError(f"{label}: {what} {text[:30]} is out of range (an integer below"
+                              " 2**63)")
+    return value
 
 
 def _numbers(items: list[str], label: str, most: int, total: list) -> np.ndarray:
