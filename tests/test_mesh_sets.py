@@ -190,8 +190,13 @@ def test_abaqus_instance_placement(placement, ok):
 
 # --- Nastran -----------------------------------------------------------------------------
 
+DECK_NOT_CARRIED = r"cards not carried into the model: PBARL x3, EIGRL x1, MAT1 x1, PSHELL x1"
+"""The cards of portal_frame.bdf that femmech does not read (properties: given per group)."""
+
+
 def test_nastran_bulk_data_sets_and_property_groups():
-    mesh = fm.read_mesh(DATA / "portal_frame.bdf")
+    with pytest.warns(fm.ModelWarning, match=DECK_NOT_CARRIED):
+        mesh = fm.read_mesh(DATA / "portal_frame.bdf")
     assert_array_equal(mesh.points, POINTS)
     assert_array_equal(mesh.cells["line"], LINES)
     assert_array_equal(mesh.cells["quad"], QUADS)
@@ -212,7 +217,8 @@ def test_nastran_bulk_data_sets_and_property_groups():
 
 
 def test_nastran_model_with_shells_equals_model_from_arrays():
-    mesh = fm.read_mesh(DATA / "portal_frame.bdf")
+    with pytest.warns(fm.ModelWarning, match=DECK_NOT_CARRIED):
+        mesh = fm.read_mesh(DATA / "portal_frame.bdf")
     roof = fm.ShellProperty(0.004, STEEL)
     from_file = fm.build_model(mesh, _renamed({"columns": "PID1", "beams_x": "PID2",
                                                "beams_y": "PID3"}),

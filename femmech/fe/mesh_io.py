@@ -175,7 +175,8 @@ def read_mesh(path) -> Mesh:
             _check_counts(len(deck.node_ids), sum(len(ids) for _, ids in deck.blocks))
             abaqus_sets.check_numbers(deck)
         found = nastran_cards.census(path) if suffix in NASTRAN_SUFFIXES else None
-        raw = _meshio_read(path, "abaqus" if deck is not None else None)
+        raw = _meshio_read(path, "abaqus" if deck is not None else
+                           "nastran" if found is not None else None)
         _check_counts(len(raw.points), sum(len(block.data) for block in raw.cells))
         check_coordinates(raw.points, getattr(raw, "points_id", None),
                           "GRID" if found is not None else "node")
@@ -203,7 +204,8 @@ def _check_counts(n_points: int, n_cells: int) -> None:
 def _meshio_read(path: Path, deck_format: str | None = None):
     """``meshio.read``, its own printed warnings kept, every failure a FileFormatError; an
     Abaqus deck (``deck_format="abaqus"``) is read without its set blocks
-    (:class:`femmech.fe.abaqus_sets.WithoutSets`)."""
+    (:class:`femmech.fe.abaqus_sets.WithoutSets`), a Nastran deck (``"nastran"``) without
+    the cards meshio fails on (:class:`femmech.fe.nastran_cards.WithoutCards`)."""
     import meshio
 
     said = io.StringIO()  # meshio prints warnings and errors of its own; keep them
@@ -211,8 +213,10 @@ def _meshio_read(path: Path, deck_format: str | None = None):
         with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
             if deck_format is None:
                 return meshio.read(path)
+            hide = abaqus_sets.WithoutSets if deck_format == "abaqus" else \
+                nastran_cards.WithoutCards
             with open(path, encoding="utf-8", errors="replace") as f:
-                return meshio.read(abaqus_sets.WithoutSets(f), deck_format)
+                return meshio.read(hide(f), deck_format)
     except KeyError as exc:
         if deck_format == "abaqus":  # sets are hidden from meshio: an element's node
             raise FileFormatError(f"an element lists node {exc.args[0]}, which the *NODE"

@@ -25,13 +25,14 @@ fe.nastran_sets (the card reader).
 
 from __future__ import annotations
 
+import io
 from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from femmech.errors import FileFormatError
-from femmech.fe.nastran_sets import SET_CARDS, bulk_cards
+from femmech.fe.nastran_sets import SET_CARDS, bulk_cards, split_line
 
 LINE_CARDS = ("CBAR", "CBEAM", "CBUSH", "CBUSH1D", "CGAP")
 """Element cards with two GRIDs and an orientation (meshio keeps the two GRIDs only)."""
@@ -43,6 +44,9 @@ cells femmech has no element for (pyramids, 15-node wedges) are refused by
 :func:`femmech.fe.mesh_io.from_meshio`; ``CELAS1``, which meshio reads as a vertex, is
 dropped (a vertex is no element) and counted here."""
 GRID_CARDS = ("GRID", "GRID*")
+HIDDEN_CARDS = ("CELAS1",)
+"""Cards hidden from meshio (:class:`WithoutCards`): it reads ``CELAS1`` as a vertex cell
+and fails on its second field ("Illegal cell type vertex"); counted as not carried."""
 MAX_ID = 2**63 - 1
 """Largest GRID or element number read (int64; Nastran itself allows 8 digits)."""
 
@@ -190,3 +194,33 @@ def _unique(ids: np.ndarray, what, where) -> None:
         raise FileFormatError(f"{what(first)} is defined twice ({where(first)} and"
                               f" {where(second)}; {twice.size} numbers defined more than"
                               " once): give each its own number")
+
+
+class WithoutCards(io.TextIOBase):
+    """The lines of an open deck without the bulk data cards :data:`HIDDEN_CARDS` (and
+    their continuation lines), for meshio's Nastran reader (which reads by ``readline``)."""
+
+    def __init__(self, f):
+        super().__init__()
+        self.f, self.in_bulk, self.skipping = f, False, False
+
+    def readable(self) -> bool:
+        return True
+
+    def read(self, size=-1):  # meshio tells a buffer by its read attribute
+        raise io.UnsupportedOperation("read by lines")
+
+    def readline(self, size=-1) -> str:
+        while True:
+            line = self.f.readline()
+            text = line.rstrip("\r\n")
+            if not self.in_bulk:
+                self.in_bulk = text.strip().upper().startswith("BEGIN BULK")
+                return line
+            if text.startswith("$") or not text.strip():
+                return line
+            name = split_line(text, raw=True)[0]
+            if name is not None:
+                self.skipping = name in HIDDEN_CARDS
+            if not line or not self.skipping:
+                return line

@@ -105,7 +105,7 @@ def bulk_cards(path, wanted=SET_CARDS, raw_names: bool = False):
                 continue
             if line.upper().startswith("ENDDATA"):
                 break
-            name, data = _split(line, raw_names)
+            name, data = split_line(line, raw_names)
             if name is None:  # a continuation line
                 if card is not None:
                     fields += data
@@ -118,8 +118,9 @@ def bulk_cards(path, wanted=SET_CARDS, raw_names: bool = False):
         yield card, fields, first
 
 
-def _split(line: str, raw: bool = False) -> tuple[str | None, list[str]]:
-    """Card name (None for a continuation line) and the data fields 2-9 of one line."""
+def split_line(line: str, raw: bool = False) -> tuple[str | None, list[str]]:
+    """Card name (None for a continuation line; as written with ``raw``, else upper case
+    without a large-field ``*``) and the data fields 2-9 of one line."""
     head = line.split(",", 1)[0] if "," in line else line[:8]
     is_continuation = head[:1] in ("+", "*") or not head.strip()
     if "," in line:
