@@ -298,3 +298,15 @@ def test_materials_at_the_ends_of_the_range_solve():
             model = fm.build_model(mesh, {"all": prop}, supports=[fm.Support(0)],
                                    masses=[fm.PointMass(4, 1.0)] if not material.rho else ())
             assert np.isfinite(fm.modes(model, 2).freq_hz).all()
+
+
+def test_abaqus_number_beyond_int64_and_far_node_name_line_and_node(tmp_path):
+    path = tmp_path / "frame.inp"
+    path.write_text("*NODE\n1, 0, 0, 0\n99999999999999999999, 1, 0, 0\n")
+    with pytest.raises(FileFormatError, match=r"frame.inp: line 3: number 99999999999999999999"
+                       " is out of range"):  # before: "int too big to convert"
+        read_quietly(path)
+    path.write_text("*NODE\n1, 0, 0, 0\n7, 1e300, 0, 0\n*ELEMENT, TYPE=B31, ELSET=ALL\n"
+                    "10, 1, 7\n")
+    with pytest.raises(FileFormatError, match=r"frame.inp: node 7 has coordinates \[1e\+300"):
+        read_quietly(path)

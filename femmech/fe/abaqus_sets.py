@@ -259,9 +259,12 @@ class _Reader:
 def _integer(token: str) -> int:
     token = token.strip()
     try:
-        return int(token)
+        value = int(token)
     except ValueError:
         raise FileFormatError(f"expected an integer, got {token[:40]!r}") from None
+    if not -2**63 <= value < 2**63:  # array('q') would raise OverflowError, naming nothing
+        raise FileFormatError(f"number {token[:30]} is out of range (an integer below 2**63)")
+    return value
 
 
 def check_numbers(deck: Deck) -> None:

@@ -178,8 +178,9 @@ def read_mesh(path) -> Mesh:
         raw = _meshio_read(path, "abaqus" if deck is not None else
                            "nastran" if found is not None else None)
         _check_counts(len(raw.points), sum(len(block.data) for block in raw.cells))
-        check_coordinates(raw.points, getattr(raw, "points_id", None),
-                          "GRID" if found is not None else "node")
+        numbers = np.frombuffer(deck.node_ids, dtype=np.int64) if deck is not None else \
+            getattr(raw, "points_id", None)
+        check_coordinates(raw.points, numbers, "GRID" if found is not None else "node")
         if deck is not None:
             raw.point_sets, raw.cell_sets = abaqus_sets.deck_sets(deck, raw)
             raw.cells_id = [np.frombuffer(ids, dtype=np.int64) for _, ids in deck.blocks]
