@@ -176,7 +176,7 @@ def read_mesh(path) -> Mesh:
             abaqus_sets.check_numbers(deck)
         found = nastran_cards.census(path) if suffix in NASTRAN_SUFFIXES else None
         raw = _meshio_read(path, "abaqus" if deck is not None else
-                           "nastran" if found is not None else None)
+                           "nastran" if found is not None and found.hidden else None)
         _check_counts(len(raw.points), sum(len(block.data) for block in raw.cells))
         numbers = np.frombuffer(deck.node_ids, dtype=np.int64) if deck is not None else \
             getattr(raw, "points_id", None)
@@ -185,7 +185,7 @@ def read_mesh(path) -> Mesh:
             raw.point_sets, raw.cell_sets = abaqus_sets.deck_sets(deck, raw)
             raw.cells_id = [np.frombuffer(ids, dtype=np.int64) for _, ids in deck.blocks]
         elif found is not None:
-            nastran_sets.add_sets(path, raw, found.ps_sets)
+            nastran_sets.add_sets(path, raw, found.ps_sets, found.set_cards)
         mesh, note = _converted(raw, "keep" if deck is not None or found is not None
                                 else "drop")
     except (ValueError, TypeError, OverflowError) as exc:  # FileFormatError, Mesh's checks

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from femmech.errors import FileFormatError
-from femmech.fe.nastran_sets import SET_CARDS, bulk_cards, split_line
+from femmech.fe.nastran_sets import SET_CARDS, bulk_cards
 
 LINE_CARDS = ("CBAR", "CBEAM", "CBUSH", "CBUSH1D", "CGAP")
 """Element cards with two GRIDs and an orientation (meshio keeps the two GRIDs only)."""
@@ -64,11 +64,18 @@ class Census:
         (sorted digits, e.g. ``"PS123"``).
     cd_grids : int
         Number of GRIDs with a displacement coordinate system CD ≠ 0.
+    set_cards : tuple
+        The ``SET1``, ``SET3`` and ``SPC1`` cards as :func:`~femmech.fe.nastran_sets.bulk_cards`
+        gives them (for :func:`~femmech.fe.nastran_sets.add_sets`).
+    hidden : bool
+        Whether the deck has cards of :data:`HIDDEN_CARDS`.
     """
 
     dropped: dict = field(default_factory=dict)
     ps_sets: dict = field(default_factory=dict)
     cd_grids: int = 0
+    set_cards: tuple = ()
+    hidden: bool = False
 
 
 def census(path) -> Census:
@@ -81,7 +88,7 @@ def census(path) -> Census:
     """
     dropped = Counter()
     grids, grid_lines, elements, element_lines, refs, ref_owner = [], [], [], [], [], []
-    ps, cd = {}, 0
+    ps, cd, set_cards = {}, 0, []
     for name, fields, line in bulk_cards(path, None, raw_names=True):
         label = f"{name} (line {line})"
         if name.upper() == "INCLUDE":
@@ -106,7 +113,9 @@ def census(path) -> Census:
                 if number is not None:
                     refs.append(number)
                     ref_owner.append(len(elements) - 1)
-        elif name.upper().rstrip("*") not in SET_CARDS:
+        elif name.upper().rstrip("*") in SET_CARDS:
+            set_cards.append((name.upper().rstrip("*"), fields, line))
+        else:
             dropped[name] += 1
     grid_ids = np.array(grids, dtype=np.int64)
     _unique(grid_ids, lambda i: f"GRID {grids[i]}", lambda i: f"line {grid_lines[i]}")
@@ -122,7 +131,8 @@ def census(path) -> Census:
                               f" {refs[missing[0]]}, which the file does not define"
                               f" ({missing.size} such references)")
     return Census(dict(dropped), {f"PS{c}": np.unique(np.array(g, dtype=np.int64))
-                                  for c, g in sorted(ps.items())}, cd)
+                                  for c, g in sorted(ps.items())}, cd, tuple(set_cards),
+                  any(name in dropped for name in HIDDEN_CARDS))
 
 
 def not_carried(found: Census) -> str | None:
@@ -217,10 +227,8 @@ class WithoutCards(io.TextIOBase):
             if not self.in_bulk:
                 self.in_bulk = text.strip().upper().startswith("BEGIN BULK")
                 return line
-            if text.startswith("$") or not text.strip():
-                return line
-            name = split_line(text, raw=True)[0]
-            if name is not None:
-                self.skipping = name in HIDDEN_CARDS
+            head = text.split(",", 1)[0] if "," in text else text[:8]
+            if head[:1] not in ("+", "*", "$") and head.strip():  # a card's first line
+                self.skipping = head.strip() in HIDDEN_CARDS
             if not line or not self.skipping:
                 return line

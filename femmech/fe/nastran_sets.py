@@ -32,11 +32,12 @@ from femmech.fe.mesh_sets import MAX_SET_MEMBERS, MAX_SETS
 SET_CARDS = ("SET1", "SET3", "SPC1")
 
 
-def add_sets(path, raw, grid_sets=None) -> None:
+def add_sets(path, raw, grid_sets=None, cards=None) -> None:
     """Add the ``SET1``, ``SET3`` and ``SPC1`` sets of the bulk data in ``path`` to the
     meshio mesh ``raw`` (as ``point_sets`` and per-block ``cell_sets``), in place, and
     the node sets ``grid_sets`` {name: GRID numbers} (the GRIDs' PS constraints,
-    :attr:`femmech.fe.nastran_cards.Census.ps_sets`)."""
+    :attr:`femmech.fe.nastran_cards.Census.ps_sets`). ``cards``: the set cards as
+    :func:`bulk_cards` gives them, if already read (else ``path`` is read)."""
     cp = raw.point_data.get("nastran:ref")
     if cp is not None and np.any(np.asarray(cp) != 0):
         cp = np.asarray(cp)
@@ -57,7 +58,7 @@ def add_sets(path, raw, grid_sets=None) -> None:
     nodes, cells, total = {}, {}, [0]
     for name, numbers in (grid_sets or {}).items():
         nodes[name] = [grids.indices(numbers, f"GRID field PS ({name})")]
-    for card, fields, line in bulk_cards(path, SET_CARDS):
+    for card, fields, line in bulk_cards(path, SET_CARDS) if cards is None else cards:
         label = f"{card} (line {line})"
         if len(nodes) + len(cells) > MAX_SETS:
             raise FileFormatError(f"{label}: more than {MAX_SETS} sets (limit MAX_SETS)")
@@ -121,19 +122,22 @@ def bulk_cards(path, wanted=SET_CARDS, raw_names: bool = False):
 def split_line(line: str, raw: bool = False) -> tuple[str | None, list[str]]:
     """Card name (None for a continuation line; as written with ``raw``, else upper case
     without a large-field ``*``) and the data fields 2-9 of one line."""
-    head = line.split(",", 1)[0] if "," in line else line[:8]
-    is_continuation = head[:1] in ("+", "*") or not head.strip()
     if "," in line:
         parts = line.split(",")
-        data = parts[1:9] if len(parts) >= 10 else parts[1:]
+        head = parts[0]
+        data = [d.strip() for d in (parts[1:9] if len(parts) >= 10 else parts[1:])]
     else:
-        large = head.strip().endswith("*") or head[:1] == "*"
-        width, count = (16, 4) if large else (8, 8)
-        data = [line[8 + width * i: 8 + width * (i + 1)] for i in range(count)]
-    data = [d.strip() for d in data]
-    if is_continuation:
+        head = line[:8]
+        large = head[:1] == "*" or head.rstrip().endswith("*")
+        data = [line[a:b].strip() for a, b in (_LARGE if large else _SMALL)]
+    name = head.strip()
+    if head[:1] in ("+", "*") or not name:  # a continuation line
         return None, data
-    return (head.strip() if raw else head.strip().rstrip("*").upper()), data
+    return (name if raw else name.rstrip("*").upper()), data
+
+
+_SMALL = tuple((8 + 8 * i, 16 + 8 * i) for i in range(8))
+_LARGE = tuple((8 + 16 * i, 24 + 16 * i) for i in range(4))
 
 
 def _skip_skin(items: list[str]) -> list[str]:
