@@ -119,10 +119,11 @@ def _converted(mesh, repeats: str) -> tuple[Mesh, str | None]:
 
 
 def _repeats_note(kind: str, found: np.ndarray, originals: np.ndarray, numbers) -> str:
-    """``2 quad elements repeat the nodes of earlier ones: 7 (as 3), ...``."""
+    """``2 quad elements repeat the nodes of an earlier one (numbers): 7 (as 3), ...``;
+    elements named by their numbers in the file (``numbers``, by index) or by index."""
     label = "numbers" if numbers is not None else "indices in the file's order"
-    named = numbers if numbers is not None else np.arange(int(found.max()) + 1)
-    pairs = ", ".join(f"{named[a]} (as {named[b]})" for a, b in
+    pairs = ", ".join(f"{a if numbers is None else numbers[a]} (as"
+                      f" {b if numbers is None else numbers[b]})" for a, b in
                       zip(found[:MAX_LISTED], originals[:MAX_LISTED], strict=True))
     more = f" and {found.size - MAX_LISTED} more" if found.size > MAX_LISTED else ""
     return (f"{found.size} {kind} elements repeat the nodes of an earlier one ({label}):"
