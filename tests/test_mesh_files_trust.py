@@ -310,3 +310,25 @@ def test_abaqus_number_beyond_int64_and_far_node_name_line_and_node(tmp_path):
                     "10, 1, 7\n")
     with pytest.raises(FileFormatError, match=r"frame.inp: node 7 has coordinates \[1e\+300"):
         read_quietly(path)
+
+
+def test_grid_ps_in_large_and_free_field(tmp_path):
+    # GRID* fields 2-5 on the first line; X3, CD, PS on the continuation line
+    grids = ("GRID*   1                               0.0             0.0             *G1\n"
+             "*G1     0.0                             123456\n"
+             "GRID,2,,0.5,0.,0.,,123456\n") + "".join(grid_card(i + 1, 0.5 * i)
+                                                      for i in range(2, 5))
+    with pytest.warns(fm.ModelWarning, match=r"node sets PS123456 \(2 GRIDs\)"):
+        mesh = read_quietly(deck(tmp_path, grids=grids))
+    assert_array_equal(mesh.node_sets["PS123456"], [0, 1])
+
+
+@pytest.mark.parametrize(("repeats", "n_quads"), [("drop", 2), ("keep", 3)])
+def test_from_meshio_repeats(repeats, n_quads):
+    from femmech.fe.mesh_io import from_meshio
+
+    raw = meshio.Mesh(PLATE_POINTS, [("quad", np.r_[PLATE_QUADS, PLATE_QUADS[1:]])])
+    with pytest.warns(fm.ModelWarning, match=r"1 quad elements repeat .*: 2 \(as 1\); dropped"
+                      if repeats == "drop" else r"2 \(as 1\); kept"):
+        mesh = from_meshio(raw, repeats=repeats)
+    assert len(mesh.cells["quad"]) == n_quads
