@@ -323,7 +323,11 @@ def test_isotropic_to_the_diagonal_direction():
     t = 0.001
     ref = mindlin(t)
     slash, back, alt = (ssss(16, t, d) for d in ("/", "\\", "alternate"))
-    assert_allclose(slash, back, rtol=1e-9)
+    # bound: the mirror meshes number their DOFs differently, so only round-off separates
+    # them. ARPACK (eigsh tol 0: Ritz values to eps) adds ~eps; the factorisation's error
+    # on this thin-plate pencil is eps·cond₂(D(K + λ₁M)D) = 2.2e-16 · 2.9e7 = 6.4e-9 in λ
+    # (roundoff.scaled_condition), 3.2e-9 in f, x10 -> 3e-8 (measured 1.5e-9 for mode 1)
+    assert_allclose(slash, back, rtol=3e-8)
     err_slash, err_alt = slash / ref - 1, alt / ref - 1
     assert np.all(np.abs(slash / alt - 1) < np.maximum(err_slash, err_alt)), (err_slash, err_alt)
     assert abs(slash[2] / slash[1] - 1) < 2 * err_slash[2]
