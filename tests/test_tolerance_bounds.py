@@ -16,12 +16,6 @@ also inside an expression such as ``1e-12 * scale``) in
 * the positional tolerance arguments of ``assert_allclose``, ``allclose``, ``isclose``
   (third and fourth) and ``approx`` (second and third);
 * an operand of an order comparison (``err < 1e-10``, ``x > -1e-12``).
-
-Sites from before the convention that are not yet audited are listed in
-``tolerance_pending.txt`` beside this file (one ``file | source line`` a line): the list may
-only shrink: a new tolerance without a bound fails. An entry whose line changed or got its
-bound matches nothing and is harmless; ``python tests/test_tolerance_bounds.py`` prints the
-sites still unbounded in the list's format, to rewrite it.
 """
 
 from __future__ import annotations
@@ -135,33 +129,13 @@ def _sites():
 
 
 def test_every_tight_tolerance_names_its_bound():
-    missing = [f"tests/{rel}:{line}: {code}" for rel, line, code in _sites()
-               if (rel, code) not in PENDING]
+    missing = [f"tests/{rel}:{line}: {code}" for rel, line, code in _sites()]
     assert not missing, (
         f"{len(missing)} tolerance(s) below {THRESHOLD:g} without a '# {MARK} ...' comment on"
         f" the line or the {LINES_ABOVE} lines above (the solver tolerance or round-off bound"
         " that justifies it; else loosen to >= 1e-8):\n" + "\n".join(missing))
 
 
-PENDING_FILE = TESTS / "tolerance_pending.txt"
-
-
-def _pending() -> frozenset[tuple[str, str]]:
-    """(file, stripped source line) of each tolerance not yet audited."""
-    rows = []
-    for line in PENDING_FILE.read_text(encoding="utf-8").splitlines():
-        if line.strip() and not line.startswith("#"):
-            rel, _, code = line.partition(" | ")
-            rows.append((rel.strip(), code.strip()))
-    return frozenset(rows)
-
-
-PENDING = _pending()
-
-
 if __name__ == "__main__":
-    print("# Tolerances below 1e-8 from before the bound convention, not yet audited (file |"
-          " source line).\n# Add a '# bound: ...' comment (or loosen) and delete the entry;"
-          " never add one.")
-    for rel, _, code in _sites():
-        print(f"{rel} | {code}")
+    for rel, line, code in _sites():  # the unbounded sites, as the test names them
+        print(f"tests/{rel}:{line}: {code}")
