@@ -15,6 +15,11 @@ LAPACK Users' Guide, ch. 4.7 and 4.8):
   ~eps λ_max / gap (Davis-Kahan);
 * a linear solve ``A x = b`` has relative forward error ~eps cond(A).
 
+Convention: a test tolerance below 1e-8 carries a comment ``# bound: ...`` on its line or
+on one of the 3 lines above, naming the solver tolerance or round-off bound (one of the
+above, or ~n eps·scale for values zero by construction) that justifies it;
+``test_tolerance_bounds.py`` enforces it (docs/accuracy.md).
+
 Imported as a top-level module, like ``hard_cases/hard_models.py``: ``tests/conftest.py``
 puts this folder on ``sys.path`` (pytest's ``prepend`` import mode).
 """
