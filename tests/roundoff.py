@@ -1,4 +1,4 @@
-"""Round-off scales of the tests' reference problems (issue 18).
+"""Round-off scales of the tests' reference problems.
 
 A tolerance at round-off level must follow from the problem, not from what one BLAS kernel
 (or thread count) happened to give: summation order differs between OpenBLAS kernels
