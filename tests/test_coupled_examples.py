@@ -192,16 +192,18 @@ def test_press_reduced_matches_full(press_run):
 
 def test_press_rigid_frame_is_frame_and_mechanism(press_run):
     # Mechanism attached at the clamped foot: the frame coordinates drop out of the
-    # bound: mechanism, so the coupled spectrum is exactly the union of the frame modes and
+    # mechanism, so the coupled spectrum is exactly the union of the frame modes and
     # Table 5.1 case 1 with the slider-crank; dense eigh on both: round-off (measured 6e-13).
     _, result = press_run
+    # bound: dense eigh round-off eps λ_max/λ on both sides (roundoff.py), measured 6e-13
     assert result["rigid_error"] < 1e-9
 
 
 def test_press_dead_centres(press, press_run):
-    # bound: At BDC and TDC U' = 0 and the rod is along the slider axis: the crank twist decouples
+    # At BDC and TDC U' = 0 and the rod is along the slider axis: the crank twist decouples
     # from ram and frame, so one branch is exactly √(c1/J1)/(2π) = 129.95 Hz (round-off).
     _, result = press_run
+    # bound: exact decoupling; the closed form against dense eigh: eps·cond of a 2-DOF block
     assert result["dead_centre_error"] < 1e-12
     f = result["sweep"].freq_hz
     # bound: the same frozen pencil at 0 and 2π: dense eigh round-off eps λ_max/λ

@@ -71,10 +71,12 @@ def test_static_rest_balances(q4):
     acc = m.accelerations(q, np.zeros(4), [0.0])
     # round-off of weight-level forces (100 eps · m_tot g) over the smallest mass (m2 + ...)
     assert np.abs(acc.qdd).max() < 100 * EPS * WEIGHT / (P["m2"] + P["m3"] + P["m5"])
-    assert q[2] == pytest.approx(0.0, abs=1e-14)  # bound: the load hangs vertically
+    # bound: Newton to round-off of weight-level terms (line above): angles to ~10 eps
+    assert q[2] == pytest.approx(0.0, abs=1e-14)  # the load hangs vertically
     F_v = P["c"] * (q[0] - P["l1"] * q[1])  # eq. 18, tension positive
     F_h = P["c"] * (q[0] + P["l2"] * q[1])
-    # bound: W_pot,1 = 0 (eq. 13, errata 24): the axle forces carry the whole weight
+    # W_pot,1 = 0 (eq. 13, errata 24): the axle forces carry the whole weight
+    # bound: Newton's residual at round-off, ~10 eps of the weight
     assert F_v + F_h == pytest.approx(-WEIGHT, rel=1e-12)
     # W_pot,2 = 0: −l1 F_v + l2 F_h + g (m3 y_S3,2 + m5 y_S5,2) = 0 with
     # y_S3,2 = ξ23 + r_S3 cos β, y_S5,2 = ξ23 + r25 cos β5 (chapter eqs. 3, 6)

@@ -143,9 +143,10 @@ def test_mitc4_rate_is_two():
 
 
 def test_wavelengths_reduce_to_the_closed_forms():
-    # bound: Euler-Bernoulli: k = (ρA ω²/EI)^¼, λ = 2π/k
+    # Euler-Bernoulli: k = (ρA ω²/EI)^¼, λ = 2π/k
     w, EI, rA = 2 * math.pi * 300.0, 1e5, 20.0
     k = sizing.flexural_wavenumber(w, EI, rA)
+    # bound: the same closed form of a few operations: a few eps
     assert_allclose(2 * math.pi / k, sizing.bending_wavelength(EI, rA, w), rtol=1e-14)
     # Timoshenko: the SS beam's k = mπ/L at its exact ω is recovered
     sec = rectangle(0.02, 0.1)

@@ -154,7 +154,7 @@ def test_fox_kapoor_sympy():
     by_root = sorted(zip((float(r.subs(p, p0)) for r in roots), exact, strict=True))
     # bound: 2x2 eigh against sympy roots: ~eps·cond(M)
     np.testing.assert_allclose(w[0], [r for r, _ in by_root], rtol=1e-12)
-    # bound: eigenvalue derivative vᵀ(dC - λ dM)v, cancelling terms: ~eps·cond(M) x100
+    # bound: eigenvalue derivative vᵀ(dC - λ dM)v, cancelling terms: ~eps·cond(M)·λ/|dλ|
     np.testing.assert_allclose(fk, [d for _, d in by_root], rtol=1e-10)
 
 

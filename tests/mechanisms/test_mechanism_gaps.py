@@ -63,7 +63,7 @@ def test_mechanism_sweep_at_speed_and_damped(case_1):
     Omega = 60.0
     result = sweep(case_1, PHI, Omega=Omega, n_modes=2)
     reference = quasi_modes(case_1, PHI, Omega)
-    # bound: dense eig of a 2x2 pencil on both sides, with Ω terms: eps·cond x100
+    # bound: dense eig of a 2x2 pencil on both sides, with Ω terms: ~eps·cond (roundoff.py)
     assert_allclose(np.sort(result.freq_hz, axis=1), reference.freq_hz, rtol=1e-10)
     damped = sweep(case_1, PHI, Omega=Omega, n_modes=2, damped=True, keep_vectors=True)
     assert damped.form == "damped"
