@@ -160,7 +160,8 @@ def _look_up() -> ThreadpoolController:
     ``mkl_get_max_threads``, after threadpoolctl has listed the loaded files. A
     controller from that first lookup misses the runtime, which then keeps its own count
     (``OMP_NUM_THREADS``, else all cores) inside every phase. So look again while the
-    list grows (once more in practice, ~2.5 ms, only when the cache is renewed).
+    list grows (once more in practice: 2.5-5 ms more, measured under load, and only when
+    the cache is renewed).
     """
     controller = ThreadpoolController()
     for _ in range(LOOK_UPS - 1):
