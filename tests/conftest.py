@@ -1,4 +1,4 @@
-"""Session setup shared by all tests: BLAS thread counts (issue 18).
+"""Session setup shared by all tests: BLAS thread counts.
 
 Round-off depends on the order of sums, which differs between OpenBLAS kernels (Haswell,
 SkylakeX, Zen, ...) and between thread counts. Tolerances must hold on any of them (see

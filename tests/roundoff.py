@@ -1,4 +1,4 @@
-"""Round-off scales of the tests' reference problems (issue 18).
+"""Round-off scales of the tests' reference problems.
 
 A tolerance at round-off level must follow from the problem, not from what one BLAS kernel
 (or thread count) happened to give: summation order differs between OpenBLAS kernels
@@ -14,6 +14,11 @@ LAPACK Users' Guide, ch. 4.7 and 4.8):
 * eigenvectors (subspaces) of a group separated by ``gap`` from the rest move by
   ~eps λ_max / gap (Davis-Kahan);
 * a linear solve ``A x = b`` has relative forward error ~eps cond(A).
+
+Convention: a test tolerance below 1e-8 carries a comment ``# bound: ...`` on its line or
+on one of the 3 lines above, naming the solver tolerance or round-off bound (one of the
+above, or ~n eps·scale for values zero by construction) that justifies it;
+``test_tolerance_bounds.py`` enforces it (docs/accuracy.md).
 
 Imported as a top-level module, like ``hard_cases/hard_models.py``: ``tests/conftest.py``
 puts this folder on ``sys.path`` (pytest's ``prepend`` import mode).

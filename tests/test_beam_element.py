@@ -107,7 +107,7 @@ def test_rigid_body_null_space(name, shear):
     assert np.all(energy <= 100 * EPS * norm_k * np.sum(U**2, axis=0))
     assert np.all(np.linalg.norm(K @ U, axis=0) <= 1e3 * EPS * norm_k * np.linalg.norm(U, axis=0))
     # exactly six eigenvalues at round-off level: the smallest elastic one (torsion of the
-    # thin I section, GJ/L ~ 1e-6 ‖K‖) lies far above 1e-10 ‖K‖, rigid ones ~eps ‖K‖
+    # bound: thin I section, GJ/L ~ 1e-6 ‖K‖) lies far above 1e-10 ‖K‖, rigid ones ~eps ‖K‖
     lam, V = np.linalg.eigh(0.5 * (K + K.T))
     assert np.all(lam >= -1e3 * EPS * norm_k)
     zero = np.abs(lam) <= 1e-10 * norm_k
@@ -223,7 +223,7 @@ def test_invariance_under_rigid_rotation(name, shear):
     assert_allclose(Kq[0], T @ K @ T.T, rtol=0, atol=1e3 * EPS * np.abs(K).max())
     assert_allclose(Mq[0], T @ M @ T.T, rtol=0, atol=1e3 * EPS * np.abs(M).max())
     # free-element frequencies unchanged: the six elastic eigenvalues of (K, M); relative
-    # round-off of eigh ~ eps cond(M) λ_max / λ (≲ 1e-9 here)
+    # bound: round-off of eigh ~ eps cond(M) λ_max / λ (≲ 1e-9 here)
     lam = sla.eigh(K, M, eigvals_only=True)[6:]
     lam_q = sla.eigh(Kq[0], Mq[0], eigvals_only=True)[6:]
     assert_allclose(lam_q, lam, rtol=1e-9)
@@ -268,12 +268,14 @@ def test_timoshenko_stiffness_equals_iie_energy(phi):
         K_quad += GAs * np.einsum("q,qi,qj->ij", wq, gamma, gamma)
         # IIE definition: constant shear strain and EI θ'' = -G As γ
         theta_xx = P.polyval(xq, P.polyder(dt) / L).T
+        # bound: constant shear strain in the IIE element: ~10 eps of its largest value
         assert_allclose(gamma, np.broadcast_to(gamma[:1], gamma.shape), atol=1e-10 * np.abs(
             gamma).max())
         assert_allclose(EI * theta_xx, -GAs * gamma, atol=1e-9 * np.abs(GAs * gamma).max())
     else:
+        # bound: θ = w' exactly (Hermite): ~10 eps of w'
         assert np.abs(gamma).max() <= 1e-12 * np.abs(w_x).max()  # θ = w' (Hermite)
-    # the polynomial fit amplifies round-off by cond(Vandermonde) ~ 1e2: tolerance 1e-10 ‖K‖
+    # bound: the polynomial fit amplifies round-off by cond(Vandermonde) ~ 1e2: tolerance 1e-10 ‖K‖
     assert_allclose(K_quad, K_ref[0], rtol=0, atol=1e-10 * scale)
 
 

@@ -153,7 +153,7 @@ def test_euler_bernoulli_frequencies(condition, direction):
         exact = beta**4 * E * inertia / (RHO * RECT.A)
         err = (omega2 - exact) / exact
         predicted = hermite_error(beta * length / n)
-        # Rayleigh-Ritz: err >= 0 (round-off allowance 1e-9, ≥ 10 eps λ_max/λ_1 here);
+        # bound: Rayleigh-Ritz: err >= 0 (round-off allowance 1e-9, ≥ 10 eps λ_max/λ_1 here);
         # magnitude: 0.8 to 1.05 times the asymptotic (β h)⁴/720 (refinement study)
         assert np.all(err >= -1e-9)
         assert np.all(err <= 1.05 * predicted)
@@ -230,6 +230,7 @@ def test_thick_timoshenko_beam_pinned_pinned():
     # O(h²) (see test_timoshenko_convergence_rate): Richardson estimate of the error of the
     # fine mesh is (coarse - fine) / 3; allow 1.2 times it, and err >= 0 (Rayleigh-Ritz)
     estimate = (coarse - fine) / 3 / ref
+    # bound: Rayleigh-Ritz err >= 0; allowance >= 10 eps λ_max/λ_1 (roundoff.py)
     assert np.all(err >= -1e-9)
     assert np.all(err <= 1.2 * estimate)
     assert np.all(err < 1e-3)
@@ -309,7 +310,7 @@ def test_torsion_shaft(section):
     result = fm.modes(model, n_modes=3)
     c2 = G_ * section.J / (RHO * section.polar_moment)
     discrete = np.array([_discrete_bar_omega2(k, n_el, length, c2) for k in (1, 2, 3)])
-    # FE = exact discrete eigenvalue up to round-off: eps λ_max/λ_1 = 1.7e-12, so 1e-10
+    # bound: FE = exact discrete eigenvalue up to round-off: eps λ_max/λ_1 = 1.7e-12, so 1e-10
     assert_allclose(result.omega2, discrete, rtol=1e-10)
     continuum = ((2 * np.arange(1, 4) - 1) / (4 * length)) ** 2 * c2
     f_err = result.freq_hz / np.sqrt(continuum) - 1
@@ -330,7 +331,7 @@ def test_axial_bar():
     axial = result.omega2[classify(model, result) == "axial"][:3]
     assert axial.size == 3
     discrete = np.array([_discrete_bar_omega2(k, n_el, length, E / RHO) for k in (1, 2, 3)])
-    # FE = exact discrete eigenvalue to round-off: eps λ_max / λ_1 = 4e-11 for this 3D model
+    # bound: FE = exact discrete eigenvalue to round-off: eps λ_max / λ_1 = 4e-11 for this 3D model
     assert_allclose(axial, discrete, rtol=1e-9)
     f_exact = (2 * np.arange(1, 4) - 1) / (4 * length) * np.sqrt(E / RHO)
     f_err = np.sqrt(axial) / (2 * np.pi) / f_exact - 1
@@ -428,6 +429,7 @@ def test_nafems_fv2():
     # the axial flexibility of the arms (a softer system: Rayleigh): a repeated pair below
     # the other five, by 0.16 % and 0.56 % here, inside the 1 % group window above
     for pair, rest in (([1, 2], 3), ([9, 10], 11)):
+        # bound: exact pair (symmetry): split by eps λ_max/λ only (roundoff.py)
         assert_allclose(f[pair[1]], f[pair[0]], rtol=1e-10)  # symmetry: exact pair
         assert f[rest] * (1 - 0.02) < f[pair[0]] < f[rest] * (1 - 1e-4)
 
@@ -456,7 +458,7 @@ def test_fv2_hub_at_rest_subspace():
     model = fv2_model(4)
     free = fm.modes(model, n_modes=8)
     clamped = fm.modes(fv2_model(4, hub_clamped=True), n_modes=8)
-    # hub-clamped: 8 equal frequencies equal to the five (round-off eps λ_max/λ = 2.6e-12)
+    # bound: hub-clamped: 8 equal frequencies equal to the five (round-off eps λ_max/λ = 2.6e-12)
     assert np.ptp(clamped.freq_hz) / clamped.freq_hz[0] < 1e-10
     assert_allclose(free.freq_hz[3:8], clamped.freq_hz[0], rtol=1e-10)
     # subspace containment: A ⊂ span(B) ⟺ all principal angles ~ 0; round-off bound
@@ -466,6 +468,7 @@ def test_fv2_hub_at_rest_subspace():
     assert _span_angles(free.shapes[:, 3:8], clamped.shapes).max() < bound
     hub = free.nodal(1)[0], free.nodal(3)[0]
     assert np.abs(hub[0][:2]).max() > 1e-3 * np.abs(free.shapes[:, 1]).max()  # pair: hub moves
+    # bound: hub at rest by symmetry: round-off eps λ_max/gap of the shapes (Davis-Kahan)
     assert np.abs(hub[1]).max() < 1e-10 * np.abs(free.shapes[:, 3]).max()  # five: hub at rest
 
 

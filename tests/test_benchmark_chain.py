@@ -31,12 +31,13 @@ def test_chain_benchmark_runs_every_method(bench, tmp_path):
             assert r["min_s"] >= 0  # values not asserted: no timing in tests
             assert r["median_s"] >= r["min_s"]
         assert np.isnan(got["dense eigh"]["max_rel_error"])
-        # the exact methods solve the same frozen problem as LAPACK: round-off (measured
+        # bound: the exact methods solve the same frozen problem as LAPACK: round-off (measured
         # <= 2e-13 up to N = 100; bisection rtol 1e-12), so 1e-9 hides no wrong root
         for name in ("assembled ARPACK", "transfer", "transfer + vectors", "cyclic"):
             assert got[name]["max_rel_error"] < 1e-9, name
         # the continuum is a model: its long-wave error μ²/24 and the smeared ends
         # (measured 8e-4 … 1e-3 for these chains), not round-off
+        # bound: lower end only: > 0 shows a model error, not round-off
         assert 1e-12 < got["continuum"]["max_rel_error"] < 1e-2
     p = bench.growth_exponents(rows)
     assert set(p) == names  # three sizes: every method gets a fitted exponent
@@ -53,4 +54,5 @@ def test_reference_falls_back_to_transfer_above_dense_max(bench, monkeypatch):
     assert {r["method"] for r in rows} == {"assembled ARPACK", "transfer", "cyclic"}
     assert all(r["reference"] == "transfer" for r in rows)
     (arpack,) = [r for r in rows if r["method"] == "assembled ARPACK"]
+    # bound: ARPACK (tol 0) against the same frozen pencil: eps λ_max/λ (roundoff.py)
     assert arpack["max_rel_error"] < 1e-9

@@ -44,11 +44,13 @@ def test_reduction_benchmark_runs_and_reports_sane_rows(bench, tmp_path):
         assert 0 <= r["median_err"] <= r["max_err"]
         assert r["max_est"] > 0
         assert np.all(np.isfinite(r["ratio"]))
+        # bound: MAC <= 1 up to round-off of normalised products: ~n eps
         assert 0 <= r["min_mac"] <= 1 + 1e-9
     # nested bases (Guyan ⊂ CB 5 ⊂ CB 10 ⊂ CB 20 ⊂ CB f_max, the lowest fixed-interface
     # modes first; CB n ⊂ CB+RV n, which adds vectors): by Rayleigh-Ritz no eigenvalue, hence
     # no largest error, can increase (slack: eigen solver round-off)
     def not_worse(a, b):
+        # bound: slack for the reduced and full solves' round-off eps λ_max/λ (roundoff.py)
         return by_case[b]["max_err"] <= by_case[a]["max_err"] * (1 + 1e-6) + 1e-10
 
     assert all(not_worse(a, b) for a, b in zip(plain, plain[1:], strict=False))

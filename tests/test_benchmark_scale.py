@@ -26,6 +26,7 @@ def test_machine_bed_mesh_has_the_documented_groups(bench):
     for centre, patch in groups["seats"]:
         assert patch.size >= 1
         assert mesh.points[centre, 2] == pytest.approx(bench.HEIGHT + bench.SEAT_HEIGHT)
+        # bound: generated coordinates: exact to ~eps of O(1) values
         assert np.all(np.abs(mesh.points[patch, 2] - bench.HEIGHT) < 1e-12)  # top plate
     with pytest.raises(ValueError, match="positive integer"):
         bench.machine_bed(0)

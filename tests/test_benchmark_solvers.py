@@ -39,11 +39,11 @@ def test_solver_benchmark_runs_every_installed_backend(bench, tmp_path):
         assert r["n_modes"] >= bench.N_MODES
         assert r["sturm_count"] == r["n_modes"]
         assert r["max_residual"] < 1e-8
-        # every backend solves the same pencil: ARPACK converges to round-off (measured
+        # bound: every backend solves the same pencil: ARPACK converges to round-off (measured
         # 1e-13), so 1e-10 leaves a margin without hiding a wrong mode
         assert r["max_freq_diff"] < 1e-10
         # the side-by-side ARPACK reference (scipy eigsh on the same factor): an independent
-        # eigensolver agrees with femmech's to round-off (measured 4e-13 on this frame)
+        # bound: eigensolver agrees with femmech's to round-off (measured 4e-13 on this frame)
         assert r["arpack_solves"] >= bench.N_MODES
         assert r["ratio_arpack"] > 0
         assert r["arpack_max_diff"] < 1e-10

@@ -76,7 +76,7 @@ def test_rows_describe_the_models_and_agree_where_they_must(suite, tiny):
     solver_rows = results["eigensolve"].rows
     from femmech.solve import direct
     assert sorted(r["solver"] for r in solver_rows) == sorted(direct.available())
-    # same pencil, every backend: ARPACK to round-off (measured <= 1e-13); 1e-10 margin
+    # bound: same pencil, every backend: ARPACK to round-off (measured <= 1e-13); 1e-10 margin
     assert all(r["max_freq_diff"] < 1e-10 for r in solver_rows)
     cb = results["craig_bampton"].rows
     assert {(r["interface"], r["variant"]) for r in cb} == {
@@ -98,7 +98,7 @@ def test_rows_describe_the_models_and_agree_where_they_must(suite, tiny):
     # accuracy (measured 1.2e-13 on this 4-cam model)
     assert coupled["max_rel_error"] < 1e-3
     assert len(coupled["per_angle"]["phi"]) == 2
-    # the ARPACK reference at one angle: an independent eigensolver on the same
+    # bound: the ARPACK reference at one angle: an independent eigensolver on the same
     # full coupled pencil agrees with femmech's full solve to round-off (measured 1e-13)
     (arpack,) = coupled["arpack"]
     assert arpack["max_rel_diff"] < 1e-9
@@ -116,6 +116,7 @@ def test_rows_describe_the_models_and_agree_where_they_must(suite, tiny):
     errors = [v["max_rel_error"] for v in variants]
     assert errors[0] < 1e-3
     assert all(v["tracked_ms"] > 0 for v in variants)
+    # bound: Rayleigh-Ritz nesting: errors grow, allowance for eps λ_max/λ round-off
     assert all(b >= a - 1e-12 for a, b in zip(errors, errors[1:], strict=False))
 
 

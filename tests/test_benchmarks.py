@@ -49,7 +49,7 @@ def test_frame_modes_benchmark_runs_and_reports_sane_rows(frame_modes, tmp_path)
     refs = modal["references"]
     assert [r["ref_s"] is not None for r in refs] == [True, True]
     assert all(r["max_rel_err"] < 1e-8 for r in refs)
-    # the loop and vectorised assemblies give the same matrices up to summation order
+    # bound: the loop and vectorised assemblies give the same matrices up to summation order
     assert assembly["elements"] == 108
     assert assembly["speedup"] > 0
     assert assembly["max_diff"] < 1e-12

@@ -52,7 +52,7 @@ def test_eigensolve_peers_solve_the_same_pencil(tiny):
     (row,) = tiny[0]["t1_eigensolve"].rows
     assert row["n"] == 1080
     assert row["ratio"] > 0
-    # femmech (Lanczos to 1e-12 Ritz residuals) and ARPACK (tol 0) on the same pencil agree
+    # bound: femmech (Lanczos to 1e-12 Ritz residuals) and ARPACK (tol 0) on the same pencil agree
     # to round-off: measured 1.6e-12 .. 5.8e-12 over the backends
     assert row["max_diff"] < 1e-9
     assert row["residual"] < 1e-6  # femmech's own residual check (measured 1e-10)
@@ -81,12 +81,13 @@ def test_interface_reduction_keeps_the_band(tiny):
         # coupled band frequencies against the whole interface: target 1e-3 (measured
         # 2e-5 .. 6e-5 on the 24k/151k frames), and the estimate within a factor 3
         assert row["err"] <= 1e-3
+        # bound: slack for a zero error: round-off of the estimate
         assert row["est"] <= 3 * row["err"] + 1e-12
 
 
 def test_sweep_rows_agree_with_lapack(tiny):
     for row in tiny[0]["t4_sweep"].rows:
-        # tracked frequencies against the bare all-pairs solve of the same pencils:
+        # bound: tracked frequencies against the bare all-pairs solve of the same pencils:
         # round-off (measured 5e-13 .. 1.4e-12)
         assert row["error"] < 1e-9
 
@@ -95,6 +96,7 @@ def test_monodromy_sides_reach_the_same_accuracy(tiny):
     for row in tiny[0]["t5_monodromy"].rows:
         # the peer's tolerance is chosen so that its spectral-radius error is at most
         # femmech's; both against the same tight reference
+        # bound: slack for equal errors: round-off, ~10 eps
         assert row["peer_err"] <= row["femmech_err"] + 1e-15
         assert row["femmech_err"] < 1e-3
 

@@ -120,6 +120,7 @@ def test_spread_keeps_order_moves_little_and_stays_inside():
     w = rng.uniform(10, 30, 25)
     left = spread_1d(x, w, 3.0, 0.0, 1000.0)
     order = np.argsort(x, kind="stable")
+    # bound: label boxes placed by float sums of widths: ~eps of O(100) px
     assert np.all(np.diff(left[order]) >= w[order][:-1] + 3.0 - 1e-9)  # order, gap
     assert left.min() >= 0.0
     assert (left + w).max() <= 1000.0
@@ -294,6 +295,7 @@ def test_sweep_task_shows_speeds_in_the_scene_unit(monkeypatch, tmp_path, unit):
         rows = list(csv.reader(f))
     column = {"rpm": "speed_rpm", "rad/s": "speed_rad_s"}[unit]
     assert rows[0][:2] == [column, "angle_deg"]
+    # bound: one unit conversion: one rounding
     assert float(rows[-1][0]) == pytest.approx(speeds[1] * speed_scale(unit), rel=1e-12)
     labels = {"rpm": ["0 rpm", "1200 rpm"], "rad/s": ["0.0 rad/s", "125.7 rad/s"]}[unit]
     assert sorted({r[0] for r in section.tables[0].rows}) == labels
@@ -322,6 +324,7 @@ def test_stability_task_shows_speeds_in_the_scene_unit(monkeypatch, tmp_path, un
         rows = list(csv.DictReader(f))
     column = {"rpm": "speed_rpm", "rad/s": "speed_rad_s"}[unit]
     assert list(rows[0])[0] == column
+    # bound: one unit conversion: one rounding
     assert [float(r[column]) for r in rows] == pytest.approx(
         [W * speed_scale(unit) for W in speeds], rel=1e-12)
     assert section.tables[0].header[0] == f"speed ({unit})"

@@ -264,7 +264,7 @@ def test_rigid_link_dense_eigenproblem_matches_hand_elimination():
     K, M = model.K.toarray(), model.M.toarray()
     ref = sla.eigh(T_hand.T @ K @ T_hand, T_hand.T @ M @ T_hand, eigvals_only=True)[:4]
     result = fm.modes(model, n_modes=4)
-    # dense LAPACK on both sides: round-off, relative to ω²
+    # bound: dense LAPACK on both sides: round-off, relative to ω²
     assert_allclose(result.omega2[:4], ref, rtol=1e-9)
 
 
@@ -278,6 +278,7 @@ def test_chained_rigid_links_move_rigidly():
     u = model.expand(rng.standard_normal(model.n_free)).reshape(-1, 6)
     for s in (2, 3):
         r = mesh.points[s] - mesh.points[1]
-        # a product of exact sparse matrices: round-off only
+        # bound: a product of exact sparse matrices: round-off only
         assert_allclose(u[s, :3], u[1, :3] + np.cross(u[1, 3:], r), rtol=0, atol=1e-14)
+        # bound: a product of exact sparse matrices: round-off only, O(1) entries
         assert_allclose(u[s, 3:], u[1, 3:], rtol=0, atol=1e-14)

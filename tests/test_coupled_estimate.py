@@ -70,10 +70,11 @@ def test_quadratic_form_equals_direct_formula():
         direct = np.array([frequency_error_estimates(model, se, s.eigenvalues[a].real,
                                                      s.vectors[a, :reduced.n_frame])
                            for a in range(PHI.size)])
-        # three terms of size ~λ cancel to λ̃ - λ: round-off ~ eps per term relative to λ
+        # bound: three terms of size ~λ cancel to λ̃ - λ: round-off ~ eps per term relative to λ
         # (measured 7.2e-16 at most); the relative tolerance covers the two LU solves of
         # cond(K_ii) up to ~1e8 (round-off ~1e-10 relative to the estimate itself)
         np.testing.assert_allclose(est, direct, rtol=1e-9, atol=1e-13)
+        # bound: the estimate's size (errors 1.3e-11 ... 2.0e-9), not a tolerance
         assert np.abs(est).max() > 1e-10  # not a comparison of zeros
 
 
@@ -84,12 +85,13 @@ def test_estimate_against_full_coupled_solve():
     modes without residual vectors leave errors up to 1.3e-9 on the cam followers' modes."""
     _, _, reduced, full, _, est = _estimates(n_modes=4, residual_vectors=False)
     true = compare_coupled(reduced, full, PHI, 8).rel_error
-    above = np.abs(true) > 1e-11  # Lanczos reference and the estimate's floor: ~1e-12
+    above = np.abs(true) > 1e-11  # bound: Lanczos reference and the estimate's floor: ~1e-12
     ratio = est[above] / true[above]
     # first order theory: ratio = 1 - O(λ/ω²_truncated); measured 0.99981 ... 0.99985 on
     # 10 modes (errors 1.3e-11 ... 2.0e-9)
     assert above.sum() >= 6
     assert np.all((ratio > 1 / 3) & (ratio < 3))
+    # bound: round-off where the reduction is exact: Lanczos floor ~1e-12 (line above)
     assert np.all(np.abs(est[~above]) < 1e-11)  # round-off where the reduction is exact
 
 
@@ -150,6 +152,7 @@ def test_kept_inertia_response_gives_the_same_forms():
     kept = coupled_error_forms(model, se)
     anew = coupled_error_forms(model, dataclasses.replace(se, inertia_response=None))
     for a, b in ((kept.G0, anew.G0), (kept.G1, anew.G1), (kept.G2, anew.G2)):
+        # bound: the same products in another order: ~n eps of the largest
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-11 * np.abs(b).max())
     plain = _machine(4, n_modes=0, residual_vectors=False)[1]
     assert plain.inertia_response is None  # nothing solved, nothing kept

@@ -49,12 +49,18 @@ def test_slider_crank_on_fixed_frame_is_table_5_1_case_1():
     assert mounted.coordinate_names == ("q_t", "u_b", "v_b", "v_g", "q")
     phi, own = np.linspace(0.0, 2 * np.pi, 25), [0, 4]
     block = np.ix_(range(25), own, own)
+    # bound: the same closed-form entries summed in another order: a few eps relative; atol for
+    # zeros, ~eps of O(1) entries
     assert_allclose(mounted.M(phi)[block], ref.M(phi), rtol=1e-12, atol=1e-12)
     for Omega, Omega_dot in ((0.0, 0.0), (30.0, 5.0)):
+        # bound: same entries in another order: a few eps; atol: round-off of the largest entries
         assert_allclose(mounted.B(phi, Omega)[block], ref.B(phi, Omega), rtol=1e-12,
                         atol=1e-9)
+        # bound: same entries in another order: a few eps relative; atol for the c2 = 2e9 entries'
+        # round-off
         assert_allclose(mounted.C(phi, Omega, Omega_dot)[block], ref.C(phi, Omega, Omega_dot),
                         rtol=1e-12, atol=1e-6)  # atol: round-off of c2 = 2e9 entries
+        # bound: same entries in another order: a few eps relative; atol: round-off of large entries
         assert_allclose(mounted.F(phi, Omega, Omega_dot)[:, own], ref.F(phi, Omega, Omega_dot),
                         rtol=1e-12, atol=1e-9)
 
@@ -69,6 +75,7 @@ def test_slider_crank_frame_coupling_at_dead_centre():
     expected[0, 0] = p["J1"]
     expected[np.ix_([1, 4], [1, 4])] = p["m2"]
     expected[3, 3] = p["m2"]  # ram carried across by the guide
+    # bound: exact inertia entries (sums of O(10) masses): a few eps
     assert_allclose(M, expected, atol=1e-12)
 
 
@@ -82,8 +89,11 @@ def test_cam_follower_with_inertia_is_table_5_1_case_1():
     ref = rheolinear(table_5_1_case(1), p, {"U": CAM})
     phi, own = np.linspace(0.0, 2 * np.pi, 25), [0, 3]
     block = np.ix_(range(25), own, own)
+    # bound: same entries in another order: a few eps relative, atol ~eps of O(1e-2) entries
     assert_allclose(mounted.M(phi)[block], ref.M(phi), rtol=1e-12, atol=1e-14)
     shaft = np.diag([p["c1"], 0.0])
+    # bound: same entries in another order: a few eps relative, atol for the c1 ~1e6 entries'
+    # round-off
     assert_allclose(mounted.C(phi, 20.0, 3.0)[block] + shaft, ref.C(phi, 20.0, 3.0),
                     rtol=1e-12, atol=1e-8)
 
@@ -106,6 +116,7 @@ def test_processing_machine_shaft_gives_chapter_stiffness(machine):
     # (the beam element's torsion is exact for uniform twist), 0.3211 m for d = 30 mm.
     lengths = machine.segment_lengths()
     G, J = machine.STEEL.shear_modulus, machine.SHAFT.J
+    # bound: G J / L against the same formula in the example: a few eps
     assert_allclose(G * J / lengths, [machine.PARAMS["cT1"], machine.PARAMS["cT2"]], rtol=1e-14)
     assert_allclose(lengths, 80.769e9 * np.pi * 0.03**4 / 32 / 2e4, rtol=1e-4)
 
@@ -144,7 +155,7 @@ def test_processing_machine_outputs(machine_run):
     sweep_ = result["sweep"]
     assert sweep_.form == "symmetric"
     assert sweep_.freq_hz.shape == (37, 9)
-    # periodic cams: the spectrum closes on itself after one revolution (round-off);
+    # bound: periodic cams: the spectrum closes on itself after one revolution (round-off);
     # the follower branches come back exchanged: they cross near 36° (a veering of
     # only 0.03 Hz, which the MAC tracking follows as a crossing)
     assert_allclose(np.sort(sweep_.freq_hz[-1]), np.sort(sweep_.freq_hz[0]), rtol=1e-9)
@@ -152,6 +163,7 @@ def test_processing_machine_outputs(machine_run):
     assert (out / "rigid_frame_check.png").stat().st_size > 10_000
     table = np.loadtxt(out / "quasi_frequencies.csv", delimiter=",", skiprows=1)
     n = sweep_.freq_hz.shape[1]  # columns: angle, n frequencies, n ζ, n MAC steps
+    # bound: the CSV holds 10 significant digits: rounding 5e-11 relative
     assert_allclose(table[:, 1:1 + n], sweep_.freq_hz, rtol=1e-9)  # written to 10 digits
 
 
@@ -183,6 +195,7 @@ def test_press_rigid_frame_is_frame_and_mechanism(press_run):
     # mechanism, so the coupled spectrum is exactly the union of the frame modes and
     # Table 5.1 case 1 with the slider-crank; dense eigh on both: round-off (measured 6e-13).
     _, result = press_run
+    # bound: dense eigh round-off eps λ_max/λ on both sides (roundoff.py), measured 6e-13
     assert result["rigid_error"] < 1e-9
 
 
@@ -190,10 +203,13 @@ def test_press_dead_centres(press, press_run):
     # At BDC and TDC U' = 0 and the rod is along the slider axis: the crank twist decouples
     # from ram and frame, so one branch is exactly √(c1/J1)/(2π) = 129.95 Hz (round-off).
     _, result = press_run
+    # bound: exact decoupling; the closed form against dense eigh: eps·cond of a 2-DOF block
     assert result["dead_centre_error"] < 1e-12
     f = result["sweep"].freq_hz
+    # bound: the same frozen pencil at 0 and 2π: dense eigh round-off eps λ_max/λ
     assert_allclose(f[-1], f[0], rtol=1e-9)  # one revolution closes the sweep
     crank_hz = np.sqrt(press.PARAMS["c1"] / press.PARAMS["J1"]) / (2 * np.pi)
+    # bound: the closed form against a 10-digit literal: 5e-11 rounding
     assert_allclose(crank_hz, 129.9494669, rtol=1e-9)
 
 
@@ -219,4 +235,5 @@ def test_press_outputs(press_run):
     assert (out / "mechanism_only.png").stat().st_size > 10_000
     table = np.loadtxt(out / "quasi_frequencies.csv", delimiter=",", skiprows=1)
     assert table.shape == (37, 1 + 3 * 8)  # angle, 8 frequencies, 8 ζ, 8 MAC steps
+    # bound: the CSV holds 10 significant digits: rounding 5e-11 relative
     assert_allclose(table[:, 1:9], result["sweep"].freq_hz, rtol=1e-9)

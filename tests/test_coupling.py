@@ -75,6 +75,7 @@ def test_rigidly_held_guide_reproduces_mechanism_alone(cam_model):
     result = sweep(system, PHI, n_modes=6, track=False)
     for a in range(PHI.size):
         expected = np.sort(np.concatenate([alone.freq_hz[a], frame]))[:6]
+        # bound: dense eigh on both sides of a decoupled pencil: eps λ_max/λ (roundoff.py)
         assert_allclose(result.freq_hz[a], expected, rtol=1e-9)
 
 
@@ -162,6 +163,7 @@ def test_tracking_follows_a_crossing():
     # and each keeps its frequency curve and shape (MAC step ~ 1).
     result = sweep(_oscillator_system(0.0), PHI, n_modes=2)
     f_q1 = np.sqrt(4000.0) / (2 * np.pi)
+    # bound: a decoupled oscillator: its frequency is exact to eigh's eps λ_max/λ
     constant = np.abs(result.freq_hz - f_q1).max(axis=0) < 1e-9 * f_q1
     assert constant.sum() == 1  # exactly one branch is the constant q1 branch
     other = result.freq_hz[:, ~constant][:, 0]
@@ -256,6 +258,7 @@ def test_speed_sweep_tracks_unsymmetric_stiffness(cam_model):
     result = parameter_sweep(lambda W: (system, W), speeds, phi=0.6, n_modes=4)
     assert result.form == "unsymmetric"
     at_rest = sweep(system, [0.6], n_modes=4, track=False)
+    # bound: the same pencil at speed 0 solved by two paths: eps λ_max/λ (roundoff.py)
     assert_allclose(result.freq_hz[0], at_rest.freq_hz[0], rtol=1e-9)
     assert np.abs(np.diff(result.freq_hz, axis=0)).max() < 0.05 * result.freq_hz.min()
     assert result.mac_step.min() > 0.99
@@ -341,6 +344,7 @@ def test_batched_angle_matrices_equal_per_angle_assembly(cam_model):
         angle = r * phi + mount.phase
         own = (m.M(angle), m.B(angle, r * Omega), m.C(angle, r * Omega, r * Omega_dot))
         for A, B in zip(got, own, strict=False):  # got also holds F
+            # bound: a congruence Pᵀ B P of exact selection matrices: a few eps
             assert_allclose(A, np.einsum("ki,akl,lj->aij", P, B, P), rtol=1e-13, atol=0)
         assert_allclose(got[3], m.F(angle, r * Omega, r * Omega_dot) @ P, rtol=1e-13)
     for damped in (True, False):
@@ -351,6 +355,7 @@ def test_batched_angle_matrices_equal_per_angle_assembly(cam_model):
                 if A is None:
                     assert not damped
                     continue
+                # bound: the same products in another order: a few eps of the largest
                 assert np.abs(A - B).max() <= 1e-13 * np.abs(B).max()
 
 
@@ -377,9 +382,13 @@ def test_dense_symmetric_drivers_agree(monkeypatch, n_modes):
         lam_ref, V_ref = dense.dense_symmetric(stiffness, M, n_modes)
         monkeypatch.undo()
         assert lam.size == n_modes
+        # bound: dense LAPACK against the monkeypatched path, same pencil: atol eps-level of λ_max
         assert_allclose(lam, lam_ref, rtol=rtol, atol=1e-12 * lam[-1])
+        # bound: M-orthonormal eigenvectors: ~n eps·cond(M)
         assert_allclose(V.T @ M @ V, np.eye(n_modes), atol=1e-10)
+        # bound: same eigenvectors from two solvers: Davis-Kahan eps λ_max/gap
         assert_allclose(np.abs(np.einsum("ij,ij->j", V, M @ V_ref)), 1.0, rtol=1e-9)
+    # bound: rigid-body λ = 0 ± eps λ_max (roundoff.py)
     assert abs(lam[0]) < 1e-10 * lam[-1]  # the rigid-body mode
 
 
@@ -401,7 +410,9 @@ def test_subspace_mac_equals_pseudo_inverse_formula():
         P = Y[:, g].T @ W @ X
         coef = np.linalg.pinv(Y[:, g].T @ W @ Y[:, g], rcond=1e-12, hermitian=True) @ P
         expected[:, g] = (np.einsum("ij,ij->j", P, coef) / nx)[:, None]
+    # bound: the same Gram products and pinv: ~eps·cond of the group's Gram matrix
     assert_allclose(subspace_mac(X, Y, groups, W), expected, rtol=1e-10)
+    # bound: a one-vector group: subspace MAC = MAC, the same products: a few eps
     assert_allclose(subspace_mac(X, Y[:, 3:4], [np.array([0])], W)[:, 0],
                     mac_matrix(X, Y[:, 3:4], W)[:, 0], rtol=1e-12)
 

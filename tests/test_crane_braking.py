@@ -71,16 +71,19 @@ def test_static_rest_balances(q4):
     acc = m.accelerations(q, np.zeros(4), [0.0])
     # round-off of weight-level forces (100 eps · m_tot g) over the smallest mass (m2 + ...)
     assert np.abs(acc.qdd).max() < 100 * EPS * WEIGHT / (P["m2"] + P["m3"] + P["m5"])
+    # bound: Newton to round-off of weight-level terms (line above): angles to ~10 eps
     assert q[2] == pytest.approx(0.0, abs=1e-14)  # the load hangs vertically
     F_v = P["c"] * (q[0] - P["l1"] * q[1])  # eq. 18, tension positive
     F_h = P["c"] * (q[0] + P["l2"] * q[1])
     # W_pot,1 = 0 (eq. 13, errata 24): the axle forces carry the whole weight
+    # bound: Newton's residual at round-off, ~10 eps of the weight
     assert F_v + F_h == pytest.approx(-WEIGHT, rel=1e-12)
     # W_pot,2 = 0: −l1 F_v + l2 F_h + g (m3 y_S3,2 + m5 y_S5,2) = 0 with
     # y_S3,2 = ξ23 + r_S3 cos β, y_S5,2 = ξ23 + r25 cos β5 (chapter eqs. 3, 6)
     _, beta, beta5 = _angles(q)
     moment = P["g"] * (P["m3"] * (P["xi23"] + P["rS3"] * np.cos(beta))
                        + P["m5"] * (P["xi23"] + P["r25"] * np.cos(beta5)))
+    # bound: moment balance of weight-level terms: ~10 eps of the weight
     assert -P["l1"] * F_v + P["l2"] * F_h + moment == pytest.approx(0.0, abs=1e-12 * WEIGHT)
 
 
@@ -89,7 +92,7 @@ def test_rest_stays_at_rest():
     law = SpeedRamp(0.0, 0.0, 1.0, phi0=4.2)  # q4 held constant
     r = integrate_second_kind(cb.model(), np.linspace(0.0, 5.0, 50), q[:3], np.zeros(3),
                               drive=law, rtol=cb.RTOL, atol=cb.ATOL)
-    # accelerations ~1e-15 m/s² act for 5 s: drift ≲ 1e-14 m; 1e-10 covers the atol
+    # bound: accelerations ~1e-15 m/s² act for 5 s: drift ≲ 1e-14 m; 1e-10 covers the atol
     assert np.abs(r.q - q[:3]).max() < 1e-10
     assert np.abs(r.qd).max() < 1e-10
 
@@ -102,7 +105,7 @@ def test_drive_force_at_rest_is_static_cylinder_force(q4):
     dphi3, beta, beta5 = _angles(q)
     expected = P["g"] * dphi3 * (P["m3"] * P["rS3"] * np.cos(beta)
                                  + P["m5"] * P["r25"] * np.cos(beta5))
-    assert_allclose(Q4, expected, rtol=1e-12)  # round-off of a few operations
+    assert_allclose(Q4, expected, rtol=1e-12)  # bound: round-off of a few operations
     assert_allclose(cb.static_force(q4), expected, rtol=1e-12)
 
 
@@ -136,6 +139,7 @@ def test_braking_swing_and_force(runs):
         # the chapter's point: braking inertia forces lift Q4 above the quasi-static force
         assert run.Q4[during].max() > 1.05 * static
         assert run.Q4[during].max() > cb.LIMIT
+        # bound: braking ends at rest: velocity set to 0 by the event, integrator round-off
         assert abs(run.qd[-1, 3]) < 1e-12  # cylinder at rest after braking
 
 
@@ -270,6 +274,7 @@ def test_crane_scene_runs_end_to_end(tmp_path):
     header = (out / "drive_event_braking_0p2s.csv").read_text().splitlines()[0]
     assert header == "t_s,force_N,q4_m,q1_m,q2_rad,q3_rad,spring1_N,spring2_N"
     assert data.shape == (2999, 8)
+    # bound: the CSV holds 10 significant digits: rounding 5e-11 relative
     assert data[:, 1].max() == pytest.approx(OLD_PEAK[0.2], rel=1e-9)  # 10 digits in CSV
     report = (out / "report.html").read_text(encoding="utf-8")
     assert "Drive-force trip and braking" in report

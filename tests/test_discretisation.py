@@ -26,6 +26,7 @@ FACTOR = 3.0  # the acceptance of issue 22: estimate within a factor 3 of the tr
 def within_factor(est, truth, trusted):
     """Ratios est/truth of the trusted modes whose true error is above round-off; the
     assertion that each lies in [1/3, 3]."""
+    # bound: truth above round-off of the frequencies (eps λ_max/λ ~1e-10 at most here)
     keep = trusted & (np.abs(truth) > 1e-9)
     ratio = est[keep] / truth[keep]
     assert keep.any()
@@ -358,6 +359,7 @@ def test_builder_function_gives_the_same_estimate_as_the_kept_inputs():
     mesh = line_mesh(3, sets={"root": [0]})
     a = discretisation_error(build, mesh=mesh, n_modes=4)
     b = discretisation_error(build(mesh), n_modes=4)
+    # bound: the same model built two ways: identical matrices, eigensolver round-off eps λ_max/λ
     assert np.allclose(a.error, b.error, rtol=1e-9)
     with pytest.raises(ValueError, match="mesh="):
         discretisation_error(build, n_modes=4)

@@ -35,6 +35,7 @@ from femmech.mechanisms import (
 
 P = mobile_crane_parameters()
 T2 = 2 * 2 * np.pi * np.sqrt(P["rS5"] / P["g"])  # two pendulum periods, s
+# bound: integrator tolerances of the run (solve_ivp), not test tolerances
 CRANE = dict(drive="q4", start=4.7, speed=-0.1, ramp_time=T2, limit=300e3, t_after=T2,
              end=2.6, max_step=0.05, rtol=1e-10, atol=1e-12)
 # Measured with the example's own implementation (commit 645c8b2, same model and settings):
@@ -74,6 +75,7 @@ def test_static_rest_is_the_examples(crane, q4):
     q = static_rest(crane, [q4])
     # the same Newton steps as the example's former code: equal to the last bit
     assert np.array_equal(q, _old_newton(crane, q4))
+    # bound: Newton on weight forces ~3e5 N: round-off ~1e3 eps·3e5 N
     assert np.abs(crane.gradient(q)[:3]).max() < 1e-9  # N: W_pot,f = 0 (weights ~3e5 N)
     if q4 == 4.7:
         assert q.tolist() == OLD_REST
@@ -95,6 +97,7 @@ def test_spring_forces_are_the_axle_forces(crane):
     q = np.array([[-0.1, 0.02, 0.1, 4.0], [0.01, -0.03, 0.0, 3.5]])
     F_v = P["c"] * (q[:, 0] - P["l1"] * q[:, 1])  # eq. 18, front axle
     F_h = P["c"] * (q[:, 0] + P["l2"] * q[:, 1])  # rear axle
+    # bound: the same two linear formulas: a few eps
     assert_allclose(spring_forces(crane, q), np.column_stack([F_v, F_h]), rtol=1e-14)
 
 
@@ -102,7 +105,7 @@ def test_spring_forces_are_the_axle_forces(crane):
 def test_travel_time_reaches_the_end(end):
     t = travel_time(4.7, end, -0.1, T2)
     position = SpeedRamp(0.0, -0.1, T2, phi0=4.7)(np.array([t]))[0][0]
-    assert position == pytest.approx(end, abs=1e-12)  # brentq to ~eps of the ramp time
+    assert position == pytest.approx(end, abs=1e-12)  # bound: brentq to ~eps of the ramp time
 
 
 def test_crane_load_case_equals_the_examples_former_numbers(crane):
@@ -115,13 +118,18 @@ def test_crane_load_case_equals_the_examples_former_numbers(crane):
     assert r.t_trip == pytest.approx(OLD_T_TRIP, abs=1e-8)
     run = r.runs[0]
     assert run.peak_force == pytest.approx(OLD_PEAK[0.2], abs=0.05)
+    # bound: the same computation as recorded: a few eps
     assert run.static_force_end == pytest.approx(OLD_STATIC_END[0.2], rel=1e-12)
+    # bound: brentq to ~eps of the trip time: a few eps of 10 s
     assert run.t_stop == pytest.approx(r.t_trip + 0.2, abs=1e-12)
     h = run.history
     assert h.t.size == 2 * 1500 - 1
     assert h.t[-1] == pytest.approx(r.t_trip + 0.2 + T2)
+    # bound: braking ends at rest: velocity set to 0 by the event, integrator round-off
     assert abs(h.qd[-1, 3]) < 1e-12  # cylinder at rest after braking
     assert h.drive_forces[h.t < r.t_trip, 0].max() < 300e3  # below the limit until the trip
+    # bound: the event is located by the integrator's root finder to ~eps of t: force error
+    # eps-level
     assert r.approach.drive_forces[-1, 0] == pytest.approx(300e3, rel=1e-9)  # event located
 
 
@@ -134,6 +142,7 @@ def test_limit_never_reached_is_flagged(crane):
     assert "did not reach the limit 900000" in r.message
     assert "'q4'" in r.message
     assert r.extreme_before_trip < 900e3
+    # bound: the run stops at the end-of-travel event, located to ~eps of t
     assert r.approach.q[-1, 3] == pytest.approx(4.5, abs=1e-9)  # ran to the end of travel
 
 
@@ -175,11 +184,14 @@ def test_rotational_drive_trips_during_the_ramp(shaft, sign):
                        t_max=5.0, samples=400)
     assert r.tripped
     assert 0 < r.t_trip < 2.0
+    # bound: the event is located to ~eps of t by the root finder
     assert r.approach.drive_forces[-1, 0] == pytest.approx(sign * 50.0, rel=1e-9)
+    # bound: a linear spring force of O(1) displacements: a few eps of 100 N
     assert_allclose(r.approach.drive_forces[:, 0], -100.0 * r.approach.q[:, 0], atol=1e-9)
     h = r.runs[0].history
     k = np.searchsorted(h.t, r.t_trip)
     # the braking starts from the speed at the trip (continuous), and ends at rest
+    # bound: the same state handed from one run to the next: a few eps
     assert h.qd[k, 1] == pytest.approx(r.approach.qd[-1, 1], rel=1e-12)
     assert h.qd[-1, 1] == 0.0
     assert sign * r.runs[0].peak_force >= 50.0

@@ -74,8 +74,10 @@ def test_cam_profile_breakpoints_are_segment_and_piece_joints():
     # segments start at 0, 90, 180, 270 deg; the modified sine has pieces at 1/8, 7/8
     # of its 90 deg rise: 180 + 11.25 and 180 + 78.75 deg
     expected = np.deg2rad([0.0, 90.0, 180.0, 191.25, 258.75, 270.0])
+    # bound: breakpoints from degree sums in radians: ~10 eps of 2π
     assert_allclose(CAM.breakpoints(), expected, atol=1e-12)
     shifted = CamProfile(CAM.segments, phi_start=np.deg2rad(100.0))
+    # bound: breakpoints from degree sums in radians, mod 2π: ~10 eps of 2π
     assert_allclose(shifted.breakpoints(), np.sort(np.mod(expected + np.deg2rad(100.0),
                                                           2 * np.pi)), atol=1e-12)
 
@@ -99,6 +101,7 @@ def test_mechanism_breakpoints_follow_the_argument_of_the_position_function():
     theta = model.breakpoints()
     assert theta.size == 2 * psi.size
     assert np.all((theta >= 0) & (theta < 2 * np.pi))
+    # bound: breakpoints from degree sums in radians, mod 2π: ~10 eps of 2π
     assert_allclose(np.sort(np.mod(2 * theta + 0.3, 2 * np.pi)),
                     np.sort(np.concatenate([psi, psi])), atol=1e-12)
     assert_allclose(_cam_model().breakpoints(), psi, atol=1e-12)
@@ -120,6 +123,7 @@ def test_drive_breakpoints_follow_ratio_and_phase(cam_machine):
                                               phase=0.2)])
     phi = drive_breakpoints(geared)
     assert phi.size == 3 * OFFSET_CAM.breakpoints().size
+    # bound: breakpoints from degree sums in radians, mod 2π: ~10 eps of 2π
     assert_allclose(np.sort(np.mod(3 * phi + 0.2, 2 * np.pi)),
                     np.sort(np.tile(OFFSET_CAM.breakpoints(), 3)), atol=1e-12)
 
@@ -144,6 +148,7 @@ def test_steps_on_breakpoints_keep_the_order_across_a_coefficient_jump():
     exact = sla.expm(A(c2) * (T - tb)) @ sla.expm(A(c1) * tb)
     for n in (8, 33, 100):
         aligned = monodromy(1.0, b, C, T, n, rtol=None, breakpoints=[tb])
+        # bound: products of n <= 100 step exponentials (expm to eps): ~n eps of the largest
         assert np.abs(aligned - exact).max() < 1e-12 * np.abs(exact).max()
     across = [np.abs(monodromy(1.0, b, C, T, n, rtol=None) - exact).max() for n in (16, 32)]
     assert min(across) > 1e-4  # what ignoring the jump costs

@@ -71,7 +71,7 @@ def test_frame_example_mass(frame_run):
         + 6.0 * sections.tube(0.06, 0.05).A
         + np.hypot(1.0, 0.9) * sections.circle(0.03).A
     ) + module.MOTOR_MASS
-    # consistent mass matrices integrate rho*A exactly: round-off only
+    # bound: consistent mass matrices integrate rho*A exactly: round-off only
     assert_allclose(result["total_mass_kg"], mass, rtol=1e-12)
 
 
@@ -79,7 +79,7 @@ def test_frame_example_mount_modes_below_rigid_body_bound(frame_run):
     _, result = frame_run
     f = result["freq_hz"][:6]
     bound = result["rigid_body_estimate_hz"]
-    # Rayleigh-Ritz on the six rigid-body motions gives upper bounds of the six lowest
+    # bound: Rayleigh-Ritz on the six rigid-body motions gives upper bounds of the six lowest
     # eigenvalues (Courant-Fischer); round-off of both solves is ~1e-10 relative.
     assert np.all(f <= bound * (1 + 1e-10))
     # the mounts (3e5..8e5 N/m) are much softer than the frame, so the bound is close:
@@ -111,10 +111,12 @@ def test_textile_shaft_reduced_matches_full(tmp_path):
     assert sweep.freq_hz.shape == (37, 6)
     assert sweep.form == "symmetric"
     # the cam law is periodic: the sweep closes on itself after one revolution
+    # bound: the same frozen pencil at 0 and 2π: eigensolver round-off eps λ_max/λ
     assert np.allclose(sweep.freq_hz[0], sweep.freq_hz[-1], rtol=1e-9)
     assert (tmp_path / "quasi_frequencies.png").stat().st_size > 10_000
     assert (tmp_path / "quasi_frequencies.csv").read_text().count("\n") == 38
     table = np.loadtxt(tmp_path / "quasi_frequencies.csv", delimiter=",", skiprows=1)
+    # bound: the CSV holds 10 significant digits: rounding 5e-11 relative
     assert np.allclose(table[:, 1:7], sweep.freq_hz, rtol=1e-9)  # written to 10 digits
     assert (tmp_path / "mac_reduced_vs_full.png").stat().st_size > 5_000
     assert (tmp_path / "coupled_mode_1.png").stat().st_size > 10_000
@@ -126,6 +128,7 @@ def test_knitting_machine_chain_example(tmp_path):
     # Issue 21 acceptance example (numbers checked in tests/test_scene_chain.py): it runs
     # from the command line's main() and writes its three charts
     result = _load("knitting_machine_chain").main(tmp_path, n_angles=13, starts=1)
+    # bound: transfer roots to 1e-12 relative against eigh's eps λ_max/λ (roundoff.py)
     assert result["max_rel_difference"]["transfer"] < 1e-9  # same problem, 1e-12 roots
     assert result["margin_after"] > result["margin_before"]
     assert [p.name for p in result["plots"]] == ["chain_sweep.png", "campbell.png",

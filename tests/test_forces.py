@@ -70,6 +70,7 @@ def test_elastic_attachment_force_is_spring_force(frame):
     ud = se.recover(r.v[:, :system.n_frame].T)[6 * 20 + 1]
     j = system.labels.index("cam.y_g")
     expected = k * (r.q[:, j] - u) + c * (r.v[:, j] - ud)
+    # bound: the same linear spring/damper formula on the same states: a few eps; atol for zeros
     assert_allclose(out.forces[:, 0], expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max())
     assert np.abs(expected).max() > 10.0  # a real load: cam inertia forces, N
 
@@ -105,4 +106,5 @@ def test_drive_torque_of_rigid_motion_is_cam_inertia_torque():
     torque = drive_forces(lagrange, r, ConstantSpeed(W))
     U1, U2 = CAM(W * t, 1), CAM(W * t, 2)
     expected = PARAMS["m2"] * U1 * U2 * W**2
+    # bound: the same closed-form torque on the same states: a few eps of the largest
     assert_allclose(torque[:, 0], expected, atol=1e-9 * np.abs(expected).max())

@@ -56,6 +56,7 @@ def test_groups_cover_elements_once_and_mesh_is_clean(bays, k):
         d = np.diff(mesh.points[lines[mesh.cell_sets[name]["line"]]], axis=1)[:, 0]
         expected = np.zeros(3)
         expected[axis] = size[axis] / bays[axis] / k
+        # bound: generated coordinates: sums of O(size) steps, ~10 eps of the size
         assert_allclose(d, np.broadcast_to(expected, d.shape), rtol=0, atol=1e-14 * max(size))
     # no element appears twice (also not reversed)
     assert len(np.unique(np.sort(lines, axis=1), axis=0)) == len(lines)
@@ -76,6 +77,7 @@ def test_node_sets():
     assert len(base_joints) == len(top_joints) == 3 * 2
     # joints sit on the grid coordinates
     grid = mesh.points[joints] / np.array(size) * np.array([2, 1, 3])
+    # bound: grid coordinates scaled to integers: ~10 eps of O(1) values
     assert_allclose(grid, np.round(grid), rtol=0, atol=1e-12)
 
 
@@ -88,6 +90,7 @@ def test_a_model_builds_and_has_sensible_modes():
     assert model.n_free == 6 * (mesh.n_nodes - 6)
     # every element has a beam property: total mass = ρ A × total member length
     length = 2 * 2 * 2.0 + 3 * 2 * 1.0 + 6 * 1.0  # beams_x, beams_y, columns (m)
+    # bound: consistent mass integrates ρ A exactly: ~n eps of the sum
     assert_allclose(model.total_mass(), 7850.0 * tube.section.A * length, rtol=1e-12)
     result = fm.modes(model, n_modes=3)
     assert not result.rigid.any()

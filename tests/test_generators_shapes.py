@@ -49,6 +49,7 @@ def test_plate_counts_and_edges(kind, nodes, cells):
     boundary = np.isclose(x, 0) | np.isclose(x, 3) | np.isclose(y, 0) | np.isclose(y, 2)
     assert_array_equal(np.sort(mesh.node_sets["edges"]), np.flatnonzero(boundary))
     assert_allclose(mesh.points[mesh.node_sets["corners"], :2], [[0, 0], [3, 0], [3, 2], [0, 2]])
+    # bound: cell areas of straight-sided cells summed: ~n eps
     assert_allclose(cell_areas(mesh, kind).sum(), 6.0, rtol=1e-14)
     assert (cell_normals(mesh, kind)[:, 2] > 0.999).all()  # counter-clockwise about +z
 
@@ -59,8 +60,10 @@ def test_quadratic_cells_put_mid_nodes_between_their_corners():
         mesh = rectangular_plate(1.0, 0.5, 2, 3, kind=kind)
         c, p = mesh.cells[kind], mesh.points
         for i, j, m in pairs:
+            # bound: midside nodes are exact averages: 1 ulp of O(1) coordinates
             assert_allclose(p[c[:, m]], 0.5 * (p[c[:, i]] + p[c[:, j]]), atol=1e-15)
         if kind == "quad9":
+            # bound: centre nodes are exact averages: ~1 ulp of O(1) coordinates
             assert_allclose(p[c[:, 8]], p[c[:, :4]].mean(axis=1), atol=1e-15)
 
 
@@ -86,6 +89,7 @@ def test_box_counts_sets_and_outward_normals(kind, end_plates):
     per = 2 if kind == "triangle" else 1
     assert len(mesh.cells[kind]) == per * (2 * nx * (ny + nz) + end_plates * 2 * ny * nz)
     area = 2 * (w + h) * L + end_plates * 2 * w * h
+    # bound: cell areas summed: ~n eps
     assert_allclose(cell_areas(mesh, kind).sum(), area, rtol=1e-13)
     centre = np.array([L, w, h]) / 2
     mid = mesh.points[mesh.cells[kind][:, :3]].mean(axis=1)
@@ -93,9 +97,11 @@ def test_box_counts_sets_and_outward_normals(kind, end_plates):
     pts = mesh.points
     for name, axis, value in [("bottom", 2, 0), ("top", 2, h), ("side_y0", 1, 0),
                               ("side_yw", 1, w), ("end_x0", 0, 0), ("end_xl", 0, L)]:
+        # bound: set nodes lie on exact grid lines: 1 ulp of O(1) coordinates
         assert_allclose(pts[mesh.node_sets[name], axis], value, atol=1e-15)
         if name in mesh.cell_sets:
             cells = mesh.cells[kind][mesh.cell_sets[name][kind]]
+            # bound: set cells lie on exact grid lines: 1 ulp of O(1) coordinates
             assert_allclose(pts[cells, axis], value, atol=1e-15)
     corners = pts[mesh.node_sets["corners"]]
     assert len(np.unique(corners.round(12), axis=0)) == 8
@@ -111,6 +117,7 @@ def test_free_box_has_six_rigid_modes_and_its_hand_mass():
     model = fm.build_model(mesh, shells={"walls": fm.ShellProperty(t, STEEL),
                                          "ends": fm.ShellProperty(2 * t, STEEL)})
     mass = STEEL.rho * (t * 2 * (0.5 + 0.3) * 1.0 + 2 * t * 2 * 0.5 * 0.3)
+    # bound: consistent mass integrates ρ t A exactly: ~n eps of the sum
     assert_allclose(model.total_mass(), mass, rtol=1e-12)
     f = fm.modes(model, n_modes=8).freq_hz
     # six rigid modes near 0 Hz (round-off of a free model: < 1e-3 Hz at this size),
@@ -134,6 +141,7 @@ def test_stiffened_plate_shares_nodes_and_its_model_has_the_hand_mass():
                            shells={"plate": fm.ShellProperty(t, STEEL)})
     stiffener_length = a + 3 * b
     mass = STEEL.rho * (t * a * b + section.A * stiffener_length)
+    # bound: consistent mass integrates ρ t A exactly: ~n eps of the sum
     assert_allclose(model.total_mass(), mass, rtol=1e-12)
 
 

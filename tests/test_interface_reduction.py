@@ -91,8 +91,10 @@ def test_interface_is_reduced(case):
     assert cc.Psi.shape[1] == cc.n_boundary
     # M_G-orthonormal with diagonal S: the CC block of K_r is diagonal, of M_r the identity
     n_c = cc.n_boundary
+    # bound: M_G-normalised eigenvectors of the dense interface problem: ~n eps·cond(M_G)
     assert np.allclose(cc.M[:n_c, :n_c], np.eye(n_c), atol=1e-9)
     Kc = cc.K[:n_c, :n_c]
+    # bound: K_r diagonal by M-orthonormality: off-diagonals ~n eps·cond(M_G) of the dense solve
     assert np.abs(Kc - np.diag(np.diag(Kc))).max() <= 1e-9 * np.abs(Kc).max()
     assert set(cc.kinds) == {"interface mode", "modal", "residual"}
 
@@ -107,6 +109,7 @@ def test_coupled_frequencies_match_whole_interface(case):
     assert band.sum() >= 10
     err = np.abs(got[band] - ref[band]) / ref[band]
     assert err.max() < 1e-3
+    # bound: Rayleigh-Ritz from above; allowance for both solvers' eps λ_max/λ (roundoff.py)
     assert np.all(got[band] >= ref[band] * (1 - 1e-9))  # Rayleigh-Ritz: from above
 
 
@@ -127,6 +130,7 @@ def test_error_estimate_tracks_true_error(case):
     f, w, X = _lowest(cc.K, cc.M, 10)
     est = interface_error_estimates(model, cc, w, X)
     true = (f - case["full"].freq_hz[:10]) / case["full"].freq_hz[:10]
+    # bound: true errors above both solves' round-off eps λ_max/λ (roundoff.py)
     big = true > 1e-9
     assert big.any()
     assert np.all((est[big] > 0.5 * true[big]) & (est[big] < 2 * true[big]))
@@ -136,6 +140,7 @@ def test_error_estimate_tracks_true_error(case):
     loads = attachment_loads(cc, system, 0.0, wc, Xc)
     est_c = interface_error_estimates(model, cc, wc, Xc[:system.n_frame], loads)
     true_c = (fc - ref) / ref
+    # bound: estimates are >= 0 in exact arithmetic; allowance ~eps-level of O(1e-3) estimates
     assert np.all(est_c[band] >= -1e-12)
     big = band & (true_c > 1e-5)
     if big.any():
@@ -180,6 +185,7 @@ def test_whole_interface_equals_plain_craig_bampton():
     cc = reduce_interface(model, top.tolist(), n_modes=20, cc_modes=1000)
     assert cc.n_boundary == se.n_interface
     a, b = _lowest(se.K, se.M, 30)[0], _lowest(cc.K, cc.M, 30)[0]
+    # bound: the same reduced pencil by two constructions: eps λ_max/λ of dense eigh
     assert np.allclose(a, b, rtol=1e-9, atol=0)
 
 

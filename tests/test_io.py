@@ -284,13 +284,15 @@ def test_real_gmsh_file_machine_frame():
         curve_length = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
         el = np.linalg.norm(np.diff(mesh.points[lines[mesh.cell_sets[name]["line"]]], axis=1),
                             axis=-1)
-        # the elements tile the curves: total length to round-off (%.16g coordinates)
+        # bound: the elements tile the curves: total length to round-off (%.16g coordinates)
         assert_allclose(el.sum(), curve_length.sum(), rtol=1e-12)
+        # bound: element lengths of a %.16g mesh: ~10 eps of h, x1e6 margin
         assert el.max() <= h * (1 + 1e-9)
         # Gmsh 1D meshing puts ceil(L / h) elements on each curve (L / h not an integer here
         # except where it is exact: 0.3 / 0.1 -> 3)
         assert len(el) == sum(int(np.ceil(length / h - 1e-9)) for length in curve_length)
     for name, coords in GEO_POINTS.items():
+        # bound: %.16g coordinates read back: ~1 ulp of O(1) values
         assert_allclose(mesh.points[mesh.node_sets[name]], coords, rtol=0, atol=1e-12)
     # nodes on the curves only once (no duplicates), and the model builds from the groups
     tube = fm.BeamProperty(sections.tube(0.06, 0.05), fm.Material(210e9, 7850, 0.3))

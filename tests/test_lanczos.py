@@ -70,7 +70,7 @@ def pencil():
 def test_block_lanczos_matches_dense(pencil, variant):
     K, M, sigma, ref, lu = pencil
     omega2, X = lanczos._block_lanczos(K, M, 14, sigma, lu, n_wanted=12, **variant)
-    # Ritz residuals <= 1e-12 |θ| give eigenvalue errors ~1e-14; both solvers' round-off
+    # bound: Ritz residuals <= 1e-12 |θ| give eigenvalue errors ~1e-14; both solvers' round-off
     # ~eps λ_max absolute: 10 eps λ_max = 7.6e-11 of λ_1 (module docstring), within 1e-10.
     # Measured 5.3e-14 for every variant
     assert_allclose(omega2[:12], ref[:12], rtol=1e-10)
@@ -125,7 +125,7 @@ def test_deflated_block_lanczos_finds_the_next_modes(pencil):
     K, M, sigma, ref, lu = pencil
     first, X = lanczos._block_lanczos(K, M, 4, sigma, lu)
     more, _ = lanczos._block_lanczos(K, M, 4, sigma, lu, deflate=X)
-    # round-off of both solvers, 10 eps λ_max = 7.6e-11 of λ_1 (module docstring);
+    # bound: round-off of both solvers, 10 eps λ_max = 7.6e-11 of λ_1 (module docstring);
     # measured 5e-14
     assert_allclose(np.sort(np.concatenate([first, more])), ref[:8], rtol=1e-10)
 
@@ -143,7 +143,7 @@ def test_factorize_like_equals_a_fresh_factorisation(pencil, name):
     b = np.random.default_rng(3).standard_normal((A.shape[0], 3))
     # same ordering, same arithmetic up to the order of sums: measured 0 (PARDISO), 2e-14
     # of the largest entry (SuperLU, CHOLMOD). Each solve has relative error ~eps cond₂(A)
-    # = 2e-11 (cond₂(A) = 9.1e4, numpy.linalg.cond, for the cut midway between λ_10 and
+    # bound: = 2e-11 (cond₂(A) = 9.1e4, numpy.linalg.cond, for the cut midway between λ_10 and
     # λ_11): 1e-9 is 50 times that
     x = fresh.solve(b)
     assert np.abs(like.solve(b) - x).max() <= 1e-9 * np.abs(x).max()
@@ -190,7 +190,8 @@ def test_pardiso_blocks_on_a_sparse_factor_are_solved_column_by_column(pencil, m
     assert np.array_equal(f.solve(block), looped)  # the same single solves
     monkeypatch.setattr(pardiso, "PARDISO_LOOP_FILL", 0)  # as for a dense (shell) factor
     x = f.solve(block)  # PARDISO's multi-right-hand-side solve
-    assert np.abs(A @ x - block).max() < 1e-9 * np.abs(block).max()  # backward error ~eps cond
+    # bound: backward error ~eps cond
+    assert np.abs(A @ x - block).max() < 1e-9 * np.abs(block).max()
 
 
 def test_shell_element_batches_do_not_change_the_matrices(monkeypatch):
@@ -282,7 +283,7 @@ def test_far_default_shift_is_moved_towards_the_wanted_eigenvalues(monkeypatch, 
     result = solve_symmetric(K, M, n_modes=20)
     assert result.sigma == pytest.approx(-1e-3 * -default)  # moved, bounded by 1e-3 |σ|
     assert result.sturm_count == result.omega2.size == 20
-    # dense reference (eigvalsh of the chain, ~eps λ_max(chain) = 1e-8 absolute, 1e-10
+    # bound: dense reference (eigvalsh of the chain, ~eps λ_max(chain) = 1e-8 absolute, 1e-10
     # of λ_1): measured 3e-12; at the unmoved shift 8.5e-10, with residuals of 1.3e-5
     assert_allclose(result.omega2, lam[:20], rtol=1e-10)
 
@@ -351,6 +352,7 @@ def test_arpack_takes_over_where_block_lanczos_does_not_converge(pencil, monkeyp
     with pytest.warns(fm.FemmechWarning, match="falling back to ARPACK"):
         result = solve_symmetric(K, M, n_modes=8, dense_below=0)
     assert result.sturm_count == result.omega2.size >= 8
+    # bound: ARPACK (tol 0) against the dense reference: eps λ_max/λ (roundoff.py)
     assert_allclose(result.omega2[:8], expected, rtol=1e-9)
 
 

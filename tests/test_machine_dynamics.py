@@ -102,6 +102,7 @@ def test_coupled_multipliers_match_direct_integration(small_cam_system):
         A = np.block([[np.zeros((n, n)), np.eye(n)], [-X]])
         return (A @ y.reshape(2 * n, 2 * n)).ravel()
 
+    # bound: integrator tolerances of the DOP853 reference, not test tolerances
     ref = solve_ivp(rhs, (0.0, T), np.eye(2 * n).ravel(), method="DOP853", rtol=1e-11,
                     atol=1e-11).y[:, -1].reshape(2 * n, 2 * n)
     errors = [np.abs(coupled_monodromy(system, Omega, n_steps=k, rtol=None) - ref).max()
@@ -128,6 +129,7 @@ def test_ritz_basis_monodromy_converges(damped_cam_system):  # noqa: F811
         V = quasi_modal_basis(system, n_modes)
         assert V.shape[0] == system.n
         assert V.shape[1] <= 8 * n_modes
+        # bound: an orthonormalised basis (QR): ~n eps
         assert_allclose(V.T @ V, np.eye(V.shape[1]), atol=1e-12)
         reduced = np.abs(np.linalg.eigvals(coupled_monodromy(system, Omega, 128,
                                                              basis=V))).max()
@@ -152,6 +154,7 @@ def test_rayleigh_coefficients_hit_the_ratio_at_both_frequencies():
     a, b = rayleigh_coefficients(0.03, 50.0, 400.0)
     for f in (50.0, 400.0):
         w = 2 * np.pi * f
+        # bound: closed-form Rayleigh coefficients, a few operations: a few eps
         assert a / (2 * w) + b * w / 2 == pytest.approx(0.03, rel=1e-14)
     assert a / (2 * 2 * np.pi * 150) + b * 2 * np.pi * 150 / 2 < 0.03  # lower inside
     with pytest.raises(ValueError, match="f1_hz < f2_hz"):
@@ -167,6 +170,7 @@ def test_growth_rate_of_a_time_invariant_oscillator_is_minus_zeta_omega():
         return 1.0, 2 * zeta * omega, omega**2, 2 * np.pi / Omega
 
     chart = stability_chart(system, [3.0, 7.0, 20.0], n_steps=16)
+    # bound: Magnus of a constant-coefficient system is exact: expm round-off ~n_steps eps
     assert_allclose(chart.growth_rate, -zeta * omega, rtol=1e-10)
     assert np.ptp(chart.spectral_radius) > 0.1
 
@@ -188,6 +192,7 @@ def test_history_plots_and_csv(tmp_path):
     assert out.stat().st_size > 5000
     assert plot_orbit(np.cos(6 * t), np.sin(6 * t), tmp_path / "o.png").stat().st_size > 5000
     csv = write_history_csv(t, {"a": np.sin(t)}, tmp_path / "h.csv")
+    # bound: CSV of repr-precision floats: round trip to ~1 ulp
     assert_allclose(np.loadtxt(csv, delimiter=",", skiprows=1)[:, 1], np.sin(t), rtol=1e-9)
     with pytest.raises(ValueError, match="panel 'x', curve 'a'"):
         plot_time_histories(t, {"x": {"a": t[:3]}}, tmp_path / "bad.png")
@@ -259,6 +264,7 @@ def test_machine_dynamics_sections_run(tmp_path, name):
     module = _load(name)
     result = module.dynamics(tmp_path, n_speeds=2, zetas=(0.01, 0.02))
     r = result["steady_state"]
+    # bound: periodic steady state solved to the linear solve's eps·cond of the harmonic system
     assert_allclose(r.q[-1], r.q[0], atol=1e-9 * np.abs(r.q).max())  # periodic
     assert result["study"].chart.spectral_radius.shape == (2, 2)
     for png in ("steady_state.png", "stability_speed.png", "stability_chart.png"):

@@ -85,6 +85,7 @@ def test_block_commutator_equals_the_dense_one():
     P, Q = A[:2], A[2:]
     dense = P @ Q - Q @ P
     scale = np.abs(P).max() * np.abs(Q).max() * 2 * n
+    # bound: the same products summed in another order: ~n eps of the scale
     assert np.abs(magnus._first_order_commutator(P, Q) - dense).max() < 1e-14 * scale
 
 
@@ -112,6 +113,7 @@ def test_agrees_with_the_old_integrator_where_it_was_accurate():
     for n in (16, 64):
         new = monodromy(M, B, C, T, n, rtol=None)
         old = _reference_magnus(M, B, C, T, n)
+        # bound: the same steps in another order: ~n eps of the products, n <= 64
         assert np.abs(new - old).max() < 1e-12 * np.abs(old).max(), n
 
 
@@ -133,6 +135,7 @@ def test_round_off_floor_on_a_stiff_system_against_an_exact_exponential():
     Phi = monodromy(M(np.zeros(1))[0], B, lambda t: np.broadcast_to(C0, (t.size, 2, 2)), T,
                     1024, rtol=None)
     rho = np.abs(np.linalg.eigvals(exact)).max()
+    # bound: 1024 step exponentials of a constant system (exact Magnus): ~n eps growth
     assert abs(np.abs(np.linalg.eigvals(Phi)).max() - rho) < 1e-11 * rho
 
 
@@ -146,6 +149,8 @@ def test_batched_levels_equal_levels_one_at_a_time():
     record = monodromy_record(M, B, C, T, 16, 1e-6, 2**12)
     assert record.converged
     fixed = [monodromy(M, B, C, T, record.n_steps // f, rtol=None) for f in (2, 1)]
+    # bound: the same fixed-step product: round-off only
     assert np.abs(record.matrix - fixed[1]).max() < 1e-13 * np.abs(fixed[1]).max()
     radii = [np.abs(np.linalg.eigvals(P)).max() for P in fixed]
+    # bound: the same radii, subtracted in another order: a few eps
     assert abs(record.error - abs(radii[1] - radii[0])) < 1e-12

@@ -52,7 +52,7 @@ def test_single_mass_on_ground_spring_frequencies_exact():
                            masses=[fm.PointMass(0, m, inertia)],
                            springs=[fm.Spring(0, None, k)])
     result = fm.modes(model, n_modes=6)
-    # f = sqrt(k / m) / 2π per uncoupled DOF; dense 6x6: round-off
+    # bound: f = sqrt(k / m) / 2π per uncoupled DOF; dense 6x6: round-off
     ref = np.sort(np.sqrt(k / np.r_[m, m, m, inertia])) / (2 * np.pi)
     assert_allclose(result.freq_hz, ref, rtol=1e-12)
 
@@ -91,8 +91,9 @@ def test_rigid_body_on_four_mounts_matches_6x6_eigenproblem():
     ref = np.sqrt(sla.eigh(K_ref, M_ref, eigvals_only=True)) / (2 * np.pi)
     result = fm.modes(model, n_modes=6)
     assert model.n_free == 6
+    # bound: assembled sums in another order: ~n eps of the largest entry
     assert_allclose(model.K_free.toarray(), K_ref, rtol=0, atol=1e-12 * np.abs(K_ref).max())
-    assert_allclose(result.freq_hz, ref, rtol=1e-10)  # dense 6x6 both: round-off
+    assert_allclose(result.freq_hz, ref, rtol=1e-10)  # bound: dense 6x6 both: round-off
 
 
 def test_node_to_node_spring_in_series_with_a_bar():
@@ -108,7 +109,9 @@ def test_node_to_node_spring_in_series_with_a_bar():
     u = model.expand(np.linalg.solve(model.K_free.toarray(), model.T.T @ f))
     EA = STEEL.E * sections.circle(0.02).A
     # series springs: u₂ = F (L / EA + 1 / k)
+    # bound: static solve of 2 springs in series: eps·cond, cond ~ EA/(kL) + 1
     assert_allclose(u[12], 1e3 * (L / EA + 1 / k), rtol=1e-12)
+    # bound: static solve of springs in series: eps·cond of the 2-spring system
     assert_allclose(u[6], 1e3 * L / EA, rtol=1e-12)
 
 
@@ -122,6 +125,7 @@ def test_spring_axes_rotate_the_stiffness():
         direction = np.zeros(6)
         direction[3 * (i // 3):3 * (i // 3) + 3] = AXES[i % 3]
         u = np.linalg.solve(K, direction)
+        # bound: static solve of one spring: a few eps; atol for the zero components
         assert_allclose(u, direction / k[i], rtol=1e-12, atol=1e-14 / k[i])
 
 
@@ -172,7 +176,7 @@ def _beam_with_masses():
 
 def test_total_mass_is_beams_plus_point_masses():
     model, section, L, masses = _beam_with_masses()
-    # ρ A L + Σ m (consistent mass: the rigid translation is exact)
+    # bound: ρ A L + Σ m (consistent mass: the rigid translation is exact)
     ref = STEEL.rho * section.A * L + sum(p.mass for p in masses)
     assert_allclose(model.total_mass(), ref, rtol=1e-13)
 
@@ -203,7 +207,7 @@ def test_rotational_inertia_about_a_point_matches_parallel_axis_theorem():
                                  np.tile(w, (model.mesh.n_nodes, 1))])
         Q[:, i] = nodal.ravel()
     I_model = Q.T @ (model.M @ Q)
-    # the consistent mass reproduces rigid motions exactly: round-off
+    # bound: the consistent mass reproduces rigid motions exactly: round-off
     assert_allclose(I_model, I_ref, rtol=0, atol=1e-12 * np.abs(I_ref).max())
 
 

@@ -90,6 +90,7 @@ def test_split_joint_is_reported_and_merging_restores_the_frame(gap):
     result = silent(fm.modes, silent(build, merged), n_modes=2)
     # the beam's interior nodes stay where the split mesh put them (up to gap off their
     # intact places): frequencies agree to ~gap / length (measured 5e-9 at gap = 1e-4)
+    # bound: floor of rtol where gap = 0: the same model, eigensolver round-off eps λ_max/λ
     assert_allclose(result.freq_hz, intact.freq_hz, rtol=max(gap, 1e-12))
 
 
@@ -101,7 +102,7 @@ def test_near_nodes_lists_ids_and_distances_and_skips_joined_and_fine_meshes():
     # 1-2: split (3e-7 m); 3-4 (1e-6 m) are joined by no element either; 5-6 share an
     # element; 3.1 m model: default tol 3.1e-4 m
     assert pairs.tolist() == [[1, 2], [3, 4]]
-    assert_allclose(dist, [3e-7, 1e-6], rtol=1e-9)  # coordinates' round-off
+    assert_allclose(dist, [3e-7, 1e-6], rtol=1e-9)  # bound: coordinates' round-off
     pairs, _ = checks.near_nodes(points, cells, joined=[(4, 3)])  # e.g. a spring
     assert pairs.tolist() == [[1, 2]]
     assert checks.near_nodes(points, cells, tol=1e-7)[0].size == 0
@@ -247,6 +248,7 @@ def test_consistent_models_in_si_and_mm_t_s_are_silent(L, Mu):
                    masses=[fm.PointMass(node, 100.0 * Mu)])
     result = silent(fm.modes, model, n_modes=3)
     ref = silent(fm.modes, silent(build, portal(), masses=[fm.PointMass(node, 100.0)]), n_modes=3)
+    # bound: the same model after the check: identical matrices, round-off eps λ_max/λ
     assert_allclose(result.freq_hz, ref.freq_hz, rtol=1e-9)
 
 

@@ -66,6 +66,7 @@ def angular():
 def swing(cartesian):
     """Two periods with projection, rtol 1e-10 (measured: 1967 evaluations)."""
     t = np.linspace(0.0, 2 * PERIOD, 201)
+    # bound: integrator tolerances of the run (not test tolerances; the asserts below allow 1e-8)
     return integrate_mixed(cartesian, t, X0, [0.0, 0.0], rtol=1e-10, atol=1e-12)
 
 
@@ -75,20 +76,22 @@ def test_pendulum_period_and_tension(swing, angular):
     # over two periods: measured 1.2e-10 m, allow 1e-8 m.
     assert_allclose(r.q[100], X0, atol=1e-8)
     assert_allclose(r.q[-1], X0, atol=1e-8)
-    # angle form, integrated tightly (rtol 1e-12): measured difference 4.1e-10 m
+    # bound: angle form, integrated tightly (rtol 1e-12): measured difference 4.1e-10 m
     s = integrate_second_kind(angular, r.t, [THETA0], [0.0], rtol=1e-12, atol=1e-14)
     assert_allclose(r.q[:, 0], LEN * np.sin(s.q[:, 0]), atol=1e-8)
     assert_allclose(r.q[:, 1], -LEN * np.cos(s.q[:, 0]), atol=1e-8)
+    # bound: pendulum period closed by an integrator at rtol 1e-12: error ~1e-12 θ per period, x1e2
     assert_allclose(s.q[100, 0], THETA0, atol=1e-10)  # measured 1.1e-13 rad
     # rope tension (fixture docstring): S = m g (3 cos θ − 2 cos θ0); max S = 75 N,
     # measured error 1.1e-8 N (the position error times m g): allow 1e-6 N
     cos_theta = -r.q[:, 1] / LEN
     assert_allclose(r.multipliers[:, 0], MASS * G * (3 * cos_theta - 2 * np.cos(THETA0)),
                     atol=1e-6)
-    # drift at round-off (f ~ L = 1 m): < 1e-12 L
+    # bound: drift at round-off (f ~ L = 1 m): < 1e-12 L
     assert r.constraint_drift.max() < 1e-12 * LEN
     assert r.velocity_drift.max() < 1e-12 * LEN
     # accelerations returned are those of the equations: ẍ = −S x/(m L) (measured exact)
+    # bound: the same formula as the integrator's right-hand side: a few eps of O(1) terms
     assert_allclose(r.qdd[:, 0], -r.multipliers[:, 0] * r.q[:, 0] / (MASS * LEN), atol=1e-9)
 
 
@@ -108,6 +111,7 @@ N_PERIODS, PER_PERIOD = 6, 20
 def long_runs(cartesian):
     """Six periods at rtol 1e-6 with the three drift treatments (20 outputs per period)."""
     t = np.linspace(0.0, N_PERIODS * PERIOD, N_PERIODS * PER_PERIOD + 1)
+    # bound: integrator tolerances of the runs, not test tolerances
     return {s: integrate_mixed(cartesian, t, X0, [0.0, 0.0], stabilization=s, rtol=1e-6,
                                atol=1e-9) for s in ("none", "projection", "baumgarte")}
 
@@ -128,6 +132,7 @@ def test_drift_without_stabilization_grows(long_runs):
 
 def test_projection_keeps_drift_at_round_off(long_runs):
     r = long_runs["projection"]
+    # bound: projection to the constraint each step: ~n eps L (measured 1.1e-16 m)
     assert r.constraint_drift.max() < 1e-12 * LEN  # measured 1.1e-16 m
     assert r.velocity_drift.max() < 1e-12 * LEN  # measured 4.4e-16 m/s
 
@@ -177,6 +182,7 @@ def test_four_bar_redundant_vs_minimal():
     q0 = [phi0, float(th0), float(ps0)]
     qd0 = [w0, funcs["U_coupler"](phi0, 1) * w0, funcs["U_rocker"](phi0, 1) * w0]
     t = np.linspace(0.0, 1.5, 76)
+    # bound: integrator tolerances of the runs, not test tolerances
     r = integrate_mixed(mixed_type(redundant, FB_PARAMS), t, q0, qd0, rtol=1e-10, atol=1e-12)
     s = integrate_second_kind(second_kind(minimal, FB_PARAMS, funcs), t, [phi0], [w0],
                               rtol=1e-10, atol=1e-12)
@@ -187,6 +193,7 @@ def test_four_bar_redundant_vs_minimal():
     assert_allclose(r.q[:, 1], th_s, atol=1e-7)
     assert_allclose(r.q[:, 2], ps_s, atol=1e-7)
     assert_allclose(r.qd[:, 0], s.qd[:, 0], atol=1e-6)  # measured 1.6e-8 rad/s
+    # bound: projection to the constraint each step: ~n eps of lengths ~0.35 m
     assert r.constraint_drift.max() < 1e-14  # m; measured 1.1e-16 (lengths ~0.35 m)
 
 
@@ -212,6 +219,7 @@ def _reference(law, t, theta0, omega0):
     def rhs(time, y):
         acc = law(np.array([time]))[2][0]
         return [y[1], -(G * np.sin(y[0]) + acc * np.cos(y[0])) / LEN]
+    # bound: integrator tolerances of the DOP853 reference, not test tolerances
     sol = solve_ivp(rhs, (t[0], t[-1]), [theta0, omega0], method="DOP853", t_eval=t,
                     rtol=1e-12, atol=1e-14)
     th, w = sol.y
@@ -224,6 +232,7 @@ def _reference(law, t, theta0, omega0):
 def test_driven_suspension_speed_ramp(carriage_pendulum):
     law = SpeedRamp(0.0, 1.5, 1.0, t_start=0.2)  # 0 → 1.5 m/s in 1 s; peak s̈ = 3 m/s²
     t = np.linspace(0.0, 4.0, 161)
+    # bound: integrator tolerances of the run, not test tolerances
     r = integrate_second_kind(carriage_pendulum, t, [0.1], [0.0], drive=law, rtol=1e-11,
                               atol=1e-13)
     th, w, thdd, force = _reference(law, t, 0.1, 0.0)
@@ -247,10 +256,11 @@ def test_constant_speed_suspension_is_galilean(carriage_pendulum, angular):
     # a uniformly moving suspension changes nothing (Galilei): the same swing as on a
     # fixed point, and the carriage force m ẍ_mass is the swing's horizontal inertia
     t = np.linspace(0.0, PERIOD, 41)
+    # bound: integrator tolerances of the runs, not test tolerances
     r = integrate_second_kind(carriage_pendulum, t, [THETA0], [0.0],
                               drive=ConstantSpeed(2.0, phi0=0.5), rtol=1e-11, atol=1e-13)
     s = integrate_second_kind(angular, t, [THETA0], [0.0], rtol=1e-11, atol=1e-13)
-    # measured identical (s̈ = 0: the same arithmetic for θ); allow 1e-9 rad
+    # bound: measured identical (s̈ = 0: the same arithmetic for θ); allow 1e-9 rad
     assert_allclose(r.q, s.q, atol=1e-9)
     th, w, thdd = r.q[:, 0], r.qd[:, 0], r.qdd[:, 0]
     assert_allclose(r.drive_forces[:, 0],
@@ -263,8 +273,10 @@ def test_event_quarter_period(angular):
         return y[0]
     bottom.terminal, bottom.direction = True, -1.0
     t = np.linspace(0.0, PERIOD, 101)
+    # bound: integrator tolerances of the run, not test tolerances
     r = integrate_second_kind(angular, t, [THETA0], [0.0], events=bottom, rtol=1e-12,
                               atol=1e-14)
+    # bound: event root found to ~eps of t; the run's rtol 1e-12 on θ moves it ~1e-12
     assert_allclose(r.t_events[0][0], PERIOD / 4, rtol=1e-9)  # measured 4.7e-14 relative
     assert r.t[-1] <= PERIOD / 4
     assert r.t.size == 26
@@ -315,6 +327,8 @@ def test_inconsistent_initial_conditions(cartesian):
                         stabilization="none")
     # the mass-weighted (here Euclidean) closest point on the circle is X0 itself, and
     # the radial velocity is removed: the motion starts from rest at X0
+    # bound: the closest-point projection of a point on the circle returns it: a few eps of O(1)
+    # values
     assert_allclose(r.q[0], X0, atol=1e-15)
     assert_allclose(r.qd[0], 0.0, atol=1e-15)
 

@@ -100,6 +100,7 @@ def test_random_values_round_trip_to_their_significant_digits():
     values = rng.standard_normal(500) * 10.0 ** rng.integers(-12, 13, 500)
     for v in values:
         text = format_value(float(v))
+        # bound: the formatter's text against the same 4-digit rounding: a few eps
         assert float(text) == pytest.approx(float(f"{v:.3e}"), rel=1e-12), (v, text)
         mantissa = text.split("e")[0].lstrip("-").replace(".", "").lstrip("0")
         assert len(mantissa) == 4 or float(text) == 0, (v, text)

@@ -130,7 +130,7 @@ def test_curves_reproduce_cubic_tip_load_deflection():
     s = points @ axis
     EI = STEEL.E * np.pi * d**4 / 64
     expected = (P * s**2 * (3 * length - s) / (6 * EI))[:, None] * load_dir
-    # round-off of the static solve: cond(K) ~ (L/d)^2 (L/h)^2 ~ 1e5, times eps, times |w|
+    # bound: round-off of the static solve: cond(K) ~ (L/d)^2 (L/h)^2 ~ 1e5, times eps, times |w|
     assert_allclose(disp, expected, rtol=0, atol=1e-9 * np.abs(expected).max())
 
 
@@ -150,8 +150,10 @@ def test_curves_with_shear_parameter_reproduce_timoshenko_field():
     points, disp = beam_deflection_curves(model, u, n_sub=10, phi=phi)
     s = points[:, 0]
     expected = P * s**2 * (3 * length - s) / (6 * STEEL.E * sec.Iz) + P * s / (G * sec.Asy)
+    # bound: static solve round-off: eps·cond(K) of the beam, cond ~1e5 (comment above)
     assert_allclose(disp[:, 1], expected, rtol=0, atol=1e-10 * expected.max())  # round-off
     default = beam_deflection_curves(model, u, n_sub=10)[1]  # the model's own Φ
+    # bound: the same interpolation of the same displacements: ~10 eps of the largest
     assert_allclose(default, disp, rtol=0, atol=1e-12 * np.abs(disp).max())
     hermite = beam_deflection_curves(model, u, n_sub=10, phi=np.zeros((1, 2)))[1][:, 1]
     assert np.abs(hermite - expected).max() > 1e-3 * expected.max()  # Φ matters here
@@ -195,12 +197,15 @@ def test_auto_scale_and_colour_field():
     mesh = mode_mesh(model, u, scale)
     size = np.ptp(model.mesh.points, axis=0).max()
     largest = np.linalg.norm(mesh.point_data["displacement"], axis=1).max()
+    # bound: definition of the scale: one product and division, a few eps
     assert_allclose(largest, SCALE_FRACTION * size, rtol=1e-12)  # definition of the scale
     magnitude = mesh.point_data["magnitude"]
     assert magnitude.min() >= 0.0
+    # bound: normalised magnitudes: a division by the maximum, 1 ulp
     assert_allclose(magnitude.max(), 1.0, rtol=1e-12)
     assert np.ptp(magnitude) > 0.5  # a fixed base and a moving tip: the colours vary
     radius = mesh.point_data["radius"]
+    # bound: radii from a linear map of magnitudes: a few eps
     assert radius.min() >= RADIUS_RANGE[0] * size * (1 - 1e-12)
     assert radius.max() <= RADIUS_RANGE[1] * size * (1 + 1e-12)
     assert mesh.n_points == len(model.beams.cells) * 9
@@ -411,9 +416,11 @@ def test_fit_camera_shows_all_points_centred():
     for view, aspect in (("iso", 4 / 3), ("xz", 1.0), (((0.2, -1, 0.4), (0, 0, 1)), 0.6)):
         camera = fit_camera(points, view, aspect, margin=0.1)
         ndc = project(camera, points, aspect)
+        # bound: projection of the scene box: a few products of O(1) values, ~10 eps
         assert np.abs(ndc).max() == pytest.approx(0.9, abs=1e-9)  # tight in one direction
         tight = int(np.argmax(np.abs(ndc).max(axis=0)))
         # centred: the extremes of the tight direction sit symmetrically
+        # bound: symmetric projection of a centred box: ~10 eps of O(1) coordinates
         assert ndc[:, tight].max() == pytest.approx(-ndc[:, tight].min(), abs=1e-9)
     with pytest.raises(ValueError, match="unknown camera 'top'"):
         fit_camera(points, "top")
@@ -422,9 +429,11 @@ def test_fit_camera_shows_all_points_centred():
 def test_screen_axes_of_the_named_views():
     points = np.eye(3)
     # xy: looking down z, y up; x to the right, z towards the viewer
+    # bound: axis permutation of O(1) coordinates: a few eps
     assert_allclose(screen_axes(fit_camera(points, "xy")), [[1, 0, 0], [0, 1, 0], [0, 0, -1]],
                     atol=1e-12)
     # xz: looking along +y, z up, x to the right, y into the screen
+    # bound: axis permutation of O(1) coordinates: a few eps
     assert_allclose(screen_axes(fit_camera(points, "xz")), [[1, 0, 0], [0, 0, 1], [0, 1, 0]],
                     atol=1e-12)
 
@@ -457,6 +466,7 @@ def test_one_scene_one_camera_for_all_modes(tmp_path, monkeypatch):
     height, width = seen[0][5][:2]
     for _, _, points, u, scale, _ in seen:
         # the scene's curves are the mode's curves (points replaced per mode)
+        # bound: the same displaced points computed twice: a few eps of O(1) coordinates
         assert_allclose(points, mode_mesh(model, u, scale).points, rtol=0, atol=1e-12)
         # nothing leaves the frame: every drawn point of every mode projects inside
         glyphs = model_glyphs(model)
@@ -516,6 +526,7 @@ def test_explicit_camera_is_used_as_given(tmp_path, monkeypatch):
     monkeypatch.setattr(ModeRenderer, "render", spy)
     position = [(0.5, -3.0, 0.2), (0.5, 0.0, 0.0), (0.0, 0.0, 1.0)]
     plot_mode(model, result, 0, tmp_path / "a.png", window_size=(200, 150), camera=position)
+    # bound: a camera position passed through: exact up to a few eps
     assert_allclose(np.array(seen[0]), np.array(position), atol=1e-12)
     with pytest.raises(ValueError, match="three 3-vectors"):
         plot_mode(model, result, 0, tmp_path / "b.png", camera=[(0, 0, 1)])

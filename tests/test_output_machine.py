@@ -81,6 +81,7 @@ def test_coupled_title_and_mechanism_glyphs():
     assert [e.label for e in deco.legend] == ["mechanism attachment"]
     corners = deco.points(1.0)
     assert corners.shape == (8, 3)
+    # bound: box corners from sums of O(1) dimensions: a few eps
     assert_allclose(corners.mean(axis=0), [0.0, 0.0, -0.16 + 0.5], atol=1e-15)
     assert_allclose(np.ptp(corners, axis=0), [0.08] * 3)  # the block's edge: half the offset
     assert mechanism_decoration([], 2.0, 0.01).legend == ()

@@ -128,6 +128,7 @@ def test_boundary_faces_of_solid_blocks():
             volume = 2 * np.einsum("ei,ei->e", X[:, 0], np.cross(X[:, 1], X[:, 2])).sum() / 6
         else:
             volume = np.einsum("ei,ei->e", X[:, 0], np.cross(X[:, 1], X[:, 2])).sum() / 6
+        # bound: the volume of a unit box from element sums: ~n eps
         assert_allclose(volume, 1.0, rtol=1e-14)
     with pytest.raises(ValueError, match="'quad' cells are not solid"):
         boundary_faces({"quad": np.zeros((1, 4), int)})
@@ -156,12 +157,15 @@ def test_shell_scale_and_colour_field():
     size = 0.6  # the plate's largest extent, m
     mesh = surface_mesh(model, u, scale)
     largest = np.linalg.norm(mesh.point_data["displacement"], axis=1).max()
+    # bound: definition of the scale: a product and a division, a few eps
     assert_allclose(largest, SCALE_FRACTION * size, rtol=1e-12)  # definition of the scale
+    # bound: normalised magnitudes: a division by the maximum, 1 ulp
     assert_allclose(mesh.point_data["magnitude"].max(), 1.0, rtol=1e-12)
     assert mesh.point_data["magnitude"].min() == 0.0  # the supported edge does not move
     assert mesh.n_cells == 24
     assert_allclose(mesh.points, model.mesh.points + mesh.point_data["displacement"], atol=0)
     # first plate mode: everything moves along z, the centre most (sin-sin shape)
+    # bound: plate mode: in-plane components are eigenvector round-off, eps·λ_max/gap
     assert_allclose(mesh.point_data["displacement"][:, :2], 0.0, atol=1e-9 * largest)
     centre = np.argmin(np.linalg.norm(model.mesh.points - [0.3, 0.2, 0.0], axis=1))
     assert mesh.point_data["magnitude"][centre] == 1.0
@@ -179,7 +183,9 @@ def test_mixed_model_shares_one_colour_scale():
     beam_disp = np.linalg.norm(beams.point_data["displacement"], axis=1)
     surf_disp = np.linalg.norm(surf.point_data["displacement"], axis=1)
     # the largest drawn displacement of both is the scale's target, reached in one of them
+    # bound: the scale's target reached by one of them: a division, a few eps
     assert_allclose(max(beam_disp.max(), surf_disp.max()), SCALE_FRACTION * 0.4, rtol=1e-12)
+    # bound: normalised magnitudes <= 1 up to 1 ulp
     assert surf.point_data["magnitude"].max() <= 1.0 + 1e-12
 
 

@@ -41,9 +41,11 @@ def test_two_dof_chain_closed_form():
     np.testing.assert_allclose(w2, [(3 - np.sqrt(5)) / 2 * k / m, (3 + np.sqrt(5)) / 2 * k / m])
     gamma = participation_factors(phi, M, np.ones((2, 1)))
     expected = m * np.array([(1 + g) ** 2 / (1 + g**2), (1 - 1 / g) ** 2 / (1 + 1 / g**2)])
+    # bound: closed-form 2-DOF modes: a few eps of O(1) terms
     np.testing.assert_allclose(gamma[:, 0] ** 2, expected, rtol=1e-12)
     np.testing.assert_allclose(expected.sum(), 2 * m, rtol=1e-14)  # the closed form itself
     np.testing.assert_allclose(rigid_body_masses(M, np.ones((2, 1))), [2 * m])
+    # bound: ratios of closed-form masses: a few eps
     np.testing.assert_allclose(cumulative_fractions(gamma**2, [2 * m])[:, 0],
                                [expected[0] / (2 * m), 1.0], rtol=1e-12)
 
@@ -57,8 +59,10 @@ def test_point_mass_on_massless_springs():
     model = fm.build_model(mesh, masses=[fm.PointMass(0, mass, inertia)],
                            springs=[fm.Spring(0, None, [1e4, 2e4, 3e4, 10.0, 20.0, 30.0])])
     props = mass_properties(model.M, mesh.points)
+    # bound: a point mass: M holds it exactly, a few eps
     assert props.total == pytest.approx(mass, rel=1e-14)
     np.testing.assert_allclose(props.centre, mesh.points[0], atol=1e-15)
+    # bound: point inertias taken from M exactly: a few eps of O(1) values
     np.testing.assert_allclose(props.inertia, np.diag(inertia), atol=1e-12)
     result = fm.modes(model, n_modes=6)
     p = participation(model, result)
@@ -66,6 +70,7 @@ def test_point_mass_on_massless_springs():
     for k in range(6):  # the mode's moving DOF
         d = int(np.argmax(np.abs(result.shapes[:, k])))
         m_eff[k, d] = (mass, mass, mass, *inertia)[d]
+    # bound: uncoupled modes: effective masses exact to eigh's eps·n of the mass
     np.testing.assert_allclose(p.effective_mass, m_eff, atol=1e-12 * mass)
     np.testing.assert_allclose(p.cumulative_fraction[-1], 1.0, rtol=1e-12)
 
@@ -107,6 +112,7 @@ def test_cantilever_effective_masses_approach_the_total_mass():
     p = participation(model, result)
     running = np.cumsum(p.effective_mass[:, 2]) / beam_mass
     assert np.all(np.diff(running) >= 0)
+    # bound: modes with effective mass above eigh's round-off eps·(beam mass) are bending modes
     bending = np.flatnonzero(p.effective_mass[:, 2] > 1e-9 * beam_mass)  # x-z bending
     assert bending.size >= 45
     expected = np.cumsum(_cantilever_fractions(45))
@@ -115,7 +121,8 @@ def test_cantilever_effective_masses_approach_the_total_mass():
     np.testing.assert_allclose(running[bending[:4]], expected[:4], rtol=1e-8)
     np.testing.assert_allclose(running[bending[:45]], expected, rtol=3e-6)
     assert running[bending[39]] < 0.99 < running[bending[40]]
-    assert p.rigid_mass[2] == pytest.approx(beam_mass, rel=1e-12)  # r_zᵀ M r_z = ρAL
+    assert p.rigid_mass[2] == pytest.approx(beam_mass, rel=1e-12)  # bound: r_zᵀ M r_z = ρAL
+    # bound: the same sum computed twice: a few eps
     assert running[-1] == pytest.approx(p.cumulative_fraction[-1, 2], rel=1e-12)
 
 
@@ -129,10 +136,12 @@ def test_supported_model_all_modes_reach_the_projection():
     R = rigid_body_vectors(model.mesh.points)
     all_z = modal_participation(shapes, model.M, R).effective_mass[:, 2].sum()
     reach = reachable_masses(model.M_free, model.T, model.M, R)
+    # bound: the same projections by two formulas: ~n eps·cond(M_free)
     assert all_z == pytest.approx(reach[2], rel=1e-10)
     assert 0.99 * beam_mass < all_z < beam_mass
     p = participation(model, fm.modes(model, n_modes=4), reference=(0.0, 0.0, 0.0),
                       reachable=True)
+    # bound: the same reachable masses: identical arithmetic up to order
     np.testing.assert_allclose(p.reachable, reach, rtol=1e-12)
 
 
@@ -154,14 +163,18 @@ def test_all_modes_of_a_small_model_sum_to_the_rigid_masses():
         props = mass_properties(model.M, model.mesh.points)
         R = rigid_body_vectors(model.mesh.points, props.centre)
         p = modal_participation(shapes, model.M, R, props.centre)
+        # bound: all modes of a small model: Σ fractions = 1 to ~n eps·cond(M) of eigh
         np.testing.assert_allclose(p.cumulative_fraction[-1], 1.0, rtol=1e-10)
         np.testing.assert_allclose(p.rigid_mass[:3], props.total, rtol=1e-13)
+        # bound: rigid masses are sums of ρ A L (exact consistent mass): ~n eps
         np.testing.assert_allclose(p.rigid_mass[3:], np.diag(props.inertia), rtol=1e-13)
+        # bound: reachable masses by projection, ~n eps·cond(M_free)
         np.testing.assert_allclose(reachable_masses(model.M_free, model.T, model.M, R),
                                    p.rigid_mass, rtol=1e-10)
     # the six rigid-body modes of the free frame carry all of it
     w2, shapes = _all_modes(free)
     p = modal_participation(shapes[:, :6], free.M, R, props.centre)
+    # bound: rigid modes from eigh: the 6-mode subspace to Davis-Kahan eps λ_max/λ_7
     np.testing.assert_allclose(p.effective_mass.sum(axis=0), p.rigid_mass, rtol=1e-9)
 
 
@@ -178,15 +191,18 @@ def test_mass_properties_of_a_beam_with_an_end_mass():
     props = mass_properties(model.M, model.mesh.points)
     total = beam + m_tip
     x_c = (beam * length / 2 + m_tip * length) / total
+    # bound: sums of ρ A L terms (exact consistent mass): ~n eps
     assert props.total == pytest.approx(total, rel=1e-13)
     np.testing.assert_allclose(props.centre, [x_c, 0.0, 0.0], atol=1e-13)
     i_zz = beam * length**2 / 12 + beam * (length / 2 - x_c) ** 2 + m_tip * (length - x_c) ** 2
+    # bound: sums of ρ A L x² terms: ~n eps
     assert props.inertia[2, 2] == pytest.approx(i_zz, rel=1e-12)
     assert props.inertia[1, 1] == pytest.approx(i_zz, rel=1e-12)  # same about y
     groups = element_group_masses(model)
     assert list(groups) == ["all"]
     assert groups["all"].kind == "beam"
     assert groups["all"].n_elements == 10
+    # bound: the same sums in another order: ~n eps
     assert groups["all"].mass + m_tip == pytest.approx(props.total, rel=1e-13)
 
 

@@ -204,7 +204,7 @@ def test_craig_bampton_mode_selection(subdivisions):
         assert se.n_modal == expected
         assert_allclose(se.modal_omega2, lam_i[:expected], rtol=tol.max())
         assert list(se.kinds).count("modal") == expected
-    # cutoff and count select the same modes: same reduced model up to mode signs
+    # bound: round-off only: cutoff and count select the same modes (up to mode signs)
     assert_allclose(se_c.K, se_n.K, rtol=1e-12, atol=0)
     lam_c, lam_n = reduced_eigen(se_c)[0], reduced_eigen(se_n)[0]
     # the reduced stiffnesses agree to 1e-12 relative (above; the fixed-interface modes'
@@ -257,7 +257,7 @@ def test_shipped_frame_acceptance(frame, residual_vectors, cutoff_factor):
     lam_r, q = reduced_eigen(se)
     f_r = np.sqrt(np.abs(lam_r[:n_band])) / (2 * np.pi)
     err = f_r / full.freq_hz[:n_band] - 1
-    # upper bounds (Rayleigh-Ritz); -1e-9: the reference's own accuracy (ARPACK residual)
+    # bound: upper bounds (Rayleigh-Ritz); -1e-9: the reference's own accuracy (ARPACK residual)
     assert np.all(err > -1e-9)
     # measured, residual vectors: max 1.4e-6 (38 coordinates beyond the interface)
     assert err.max() < 1e-3
@@ -345,7 +345,7 @@ def test_error_estimates_vanish_for_exact_reduction(grid):
     assert se.n_residual == 0  # residual vectors add nothing to a complete basis
     lam_r, q = reduced_eigen(se)
     est = frequency_error_estimates(model, se, lam_r[:10], q[:, :10])
-    # the residual is round-off, r ~ eps ‖K‖ ‖x‖, so the estimate ~ ‖r‖² / (λ λ_min(K_ii))
+    # bound: the residual is round-off, r ~ eps ‖K‖ ‖x‖, so the estimate ~ ‖r‖² / (λ λ_min(K_ii))
     # ~ eps² cond(K) λ_max / λ ~ 1e-20 (measured 1e-25)
     assert np.abs(est).max() < 1e-16
 
@@ -495,6 +495,8 @@ def test_repeated_fixed_interface_modes(cube):
     assert cluster == 66
     se = craig_bampton(model, "joints", n_modes=5, residual_vectors=False)
     assert se.n_modal == cluster  # the whole cluster, never a cut one
+    # bound: the cluster from the interior eigenproblem against dense eigh: eps λ_max/λ
+    # (roundoff.py)
     assert_allclose(se.modal_omega2, lam_i[:cluster], rtol=1e-9)
     # cutoff between the first two clusters (frequencies of a band search)
     gap = np.flatnonzero(lam_i[1:] > lam_i[:-1] * 1.05)[0]
@@ -524,5 +526,5 @@ def test_projection_in_column_blocks_equals_the_dense_projection(grid, monkeypat
     T[np.ix_(se.free_interior, np.arange(n_b, T.shape[1]))] = se.Phi
     for reduced, full in ((se.K, K), (se.M, M)):
         ref = T.T @ full @ T
-        # round-off: sums of ~n products of the entries' magnitude
+        # bound: round-off: sums of ~n products of the entries' magnitude
         assert_allclose(reduced, ref, rtol=0, atol=1e-12 * np.abs(ref).max())

@@ -132,12 +132,14 @@ def test_refined_beam_model_static_deflection_and_mass():
     fine = refined_model(coarse)
     assert fine.mesh.n_nodes == 9
     assert len(fine.beams.cells) == 8
-    # the beam element's stiffness is exact for end loads: the same tip motion to round-off
+    # bound: the beam element's stiffness is exact for end loads: the same tip motion to round-off
     for direction in range(3):
         a, b = static_tip(coarse, direction), static_tip(fine, direction)
         assert np.allclose(a, b, rtol=1e-9, atol=1e-12 * np.abs(a).max())
+    # bound: mass sums of ρ A L over split elements: ~n eps
     assert np.isclose(fine.total_mass(), coarse.total_mass(), rtol=1e-12)
     # children keep their parent's local axes (orientation vector) and properties
+    # bound: frames copied from the parents: exact up to a few eps
     assert np.allclose(fine.beams.frames[::2], coarse.beams.frames, atol=1e-14)
     assert np.array_equal(fine.beams.properties[::2], coarse.beams.properties)
     assert np.array_equal(fine.beams.group[1::2], coarse.beams.group)
@@ -149,6 +151,7 @@ def test_refined_shell_model_keeps_mass_and_index_supports():
     model = fm.build_model(mesh, shells={"plate": fm.ShellProperty(0.01, STEEL)},
                            supports=[fm.Support(left)])
     fine = refined_model(model)
+    # bound: mass sums of ρ A L over split elements: ~n eps
     assert np.isclose(fine.total_mass(), model.total_mass(), rtol=1e-12)
     fixed = np.flatnonzero(np.diff(fine.T.tocsr().indptr) == 0) // 6
     assert np.array_equal(np.unique(fixed), np.flatnonzero(fine.mesh.points[:, 0] == 0))
@@ -186,6 +189,7 @@ def test_quadratic_shells_split_in_four_on_their_own_map(kind, cells):
     # a 3 x 2 patch of elements on the (7 x 5)-node grid, bent onto a cylinder z = x²/4
     # (exactly quadratic: the parent's map reproduces it, so the children lie on it)
     points, c = plate_cells(3, kind)
+    # bound: coordinates of a 3-node-per-side grid: exact to ~eps of O(1)
     keep = points[:, 1] <= 2 / 3 + 1e-12
     new = np.cumsum(keep) - 1
     c = new[c[np.all(keep[c], axis=1)]]

@@ -287,7 +287,9 @@ def test_frame_effective_masses_approach_the_total_mass_as_modes_are_added():
     assert np.all(fraction[11] > fraction[5])
     assert np.all(fraction[11] > 0.999)
     assert np.all(fraction[-1] > fraction[11])
+    # bound: cumulative fractions <= 1 up to ~n eps of the sums
     assert np.all(fraction[-1] <= 1 + 1e-12)
+    # bound: rigid masses: sums of ρ A L (exact consistent mass), ~n eps
     np.testing.assert_allclose(p.rigid_mass[:3], model.total_mass(), rtol=1e-12)
 
 

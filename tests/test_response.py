@@ -52,7 +52,8 @@ def test_periodic_steady_state_matches_harmonic_solution():
     for n_steps in (32, 64, 128, 256):
         r = periodic_steady_state(_oscillator(), W, n_steps=n_steps, rtol=None)  # fixed h
         errors.append(np.abs(r.q[:, 0] - X * np.cos(W * r.t - delta)).max() / X)
-        assert abs(r.q[-1, 0] - r.q[0, 0]) < 1e-12 * X  # periodic to round-off
+        assert abs(r.q[-1, 0] - r.q[0, 0]) < 1e-12 * X  # bound: periodic to round-off
+        # bound: periodic to round-off: eps·cond of the harmonic system
         assert abs(r.v[-1, 0] - r.v[0, 0]) < 1e-12 * X * W
     slopes = -np.diff(np.log(errors)) / np.log(2.0)
     assert_allclose(slopes, 2.0, atol=0.05)  # generalised-α is second order
@@ -116,6 +117,7 @@ def test_second_order_with_time_varying_coefficients():
         return [z[1], (m.F(np.array([t]), 1.0)[0, 0] - m.B(np.array([t]), 1.0)[0, 0, 0] * z[1]
                        - m.C(np.array([t]), 1.0)[0, 0, 0] * z[0]) / m.M(np.array([t]))[0, 0, 0]]
 
+    # bound: integrator tolerances of the reference run, not test tolerances
     ref = solve_ivp(rhs, (0.0, 5.0), [0.1, 0.0], rtol=1e-12, atol=1e-14).y[0, -1]
     errors = [abs(time_response(m, np.linspace(0.0, 5.0, n + 1), ConstantSpeed(1.0),
                                 q0=[0.1]).q[-1, 0] - ref) for n in (200, 400, 800)]
@@ -207,7 +209,9 @@ def test_coupled_periodic_state_and_long_integration_agree(cam_system):
     W, n = 2 * np.pi * 5.0, 512  # 5 rev/s, cam harmonics well below the 62 Hz mode
     r = periodic_steady_state(system, W, n_steps=n, rtol=None)  # the grid of `long` below
     scale = np.abs(r.q).max()
+    # bound: periodic solve: round-off eps·cond of the harmonic system of n = 512 steps
     assert np.abs(r.q[-1] - r.q[0]).max() < 1e-10 * scale
+    # bound: periodic solve: round-off eps·cond of the harmonic system of n = 512 steps
     assert np.abs(r.v[-1] - r.v[0]).max() < 1e-10 * np.abs(r.v).max()
     # 6 periods from rest: the slowest free motion decays within ~0.15 s (ζω ≥ 7 1/s),
     # e^-8 after 1.2 s. Both runs use the same steps, so they differ only by the initial
@@ -256,6 +260,7 @@ def test_frame_history_matches_full_recovery(cam_system):
     u = frame_history(system, fe, r.q, dofs)
     full = system.frame.recover(r.q[:, :system.n_frame].T)  # (n_dof, n_t)
     expected = full[[61, 6 * 20 + 1, 6 * 30 + 5]].T
+    # bound: modal recovery of the same displacements: a few eps; atol for zeros
     assert_allclose(u, expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())
 
 

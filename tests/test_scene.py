@@ -143,10 +143,11 @@ def test_frame_scene_builds_the_example_model():
     prepared = prepare(scene)
     model = part_model(scene, scene.parts["frame"], prepared.meshes["frame"])
     reference = _load("frame_modes").build()
-    # unit strings ("100 mm", "210 GPa") become the example's SI floats up to one rounding,
+    # bound: unit strings ("100 mm", "210 GPa") become the example's SI floats up to one rounding,
     # so the matrices agree to round-off of the assembly
     for A, B in ((model.K_free, reference.K_free), (model.M_free, reference.M_free)):
         assert abs(A - B).max() <= 1e-12 * abs(B).max()
+    # bound: unit strings converted with one rounding each: eigensolver round-off eps λ_max/λ
     assert_allclose(fm.modes(model, n_modes=6).freq_hz, fm.modes(reference, n_modes=6).freq_hz,
                     rtol=1e-9)
 

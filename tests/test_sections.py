@@ -88,6 +88,7 @@ def test_i_section_composite_areas_and_open_section_torsion():
     A = 2 * b * tf + hw * tw
     Iy = 2 * (b * tf**3 / 12 + b * tf * ((h - tf) / 2) ** 2) + tw * hw**3 / 12
     Iz = 2 * tf * b**3 / 12 + hw * tw**3 / 12
+    # bound: closed-form section properties: a few eps
     assert_allclose([s.A, s.Iy, s.Iz], [A, Iy, Iz], rtol=1e-12)
     # catalogue IPE 300: A = 53.8 cm² including 4 fillets of r = 15 mm, (4 - π) r² = 1.93 cm²
     assert_allclose(s.A + (4 - np.pi) * 0.015**2, 53.8e-4, rtol=1e-3)

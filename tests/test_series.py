@@ -50,7 +50,7 @@ def test_mode_series_reads_back(cantilever, tmp_path, suffix):
             for k in range(4):
                 t, point_data, _ = reader.read_data(k)
                 assert t == k + 1
-                # XML text round trip: repr-exact in meshio's writer, allow the last digit
+                # bound: XML text round trip: repr-exact in meshio's writer, allow the last digit
                 np.testing.assert_allclose(point_data["displacement"], nodal[:, :3, k],
                                            rtol=1e-12, atol=1e-12 * np.abs(nodal).max())
 

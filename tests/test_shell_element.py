@@ -70,11 +70,14 @@ def test_exactly_six_zero_energy_modes_which_are_rigid(name):
     # scale DOFs to unit length so that translations and rotations compare
     lam, vec = np.linalg.eigh(K)
     scale = lam[-1]
+    # bound: rigid eigenvalues of eigh: eps·scale (round-off); elastic ones > 1e-9 scale
     n_zero = np.sum(lam < 1e-12 * scale)
     assert n_zero == 6, lam[:8] / scale
     # the smallest elastic eigenvalue (drilling/bending, t/L = 0.02) is far above round-off
+    # bound: the lowest elastic eigenvalue lies far above eigh's eps·scale round-off
     assert lam[6] > 1e-9 * scale
     rigid = _rigid_modes(X)
+    # bound: rigid motions: K r = 0 in exact arithmetic, ~n eps·scale·|r|
     assert np.abs(K @ rigid).max() < 1e-12 * scale * np.abs(rigid).max()
     # the null space equals the span of the rigid-body motions (principal angles ~ 0)
     angles = sl.subspace_angles(vec[:, :6], rigid)
@@ -87,12 +90,14 @@ def test_mass_and_rotary_inertia(name):
     A = _area(X)
     rigid = _rigid_modes(X)
     for i in range(3):  # each rigid translation carries ρ t A (exact quadrature)
+        # bound: consistent mass integrated exactly: ~n eps
         assert_allclose(rigid[:, i] @ M @ rigid[:, i], RHO * T * A, rtol=1e-12)
     if name == "warped":  # nodal rotations also move the offset (projected) nodes
         return
     for i in range(3):  # nodal rotations only: ρ t³/12 A about every axis
         e = np.zeros((len(X), 6))
         e[:, 3 + i] = 1.0
+        # bound: consistent mass integrated exactly: ~n eps
         assert_allclose(e.ravel() @ M @ e.ravel(), RHO * T**3 / 12 * A, rtol=1e-12)
 
 
@@ -106,7 +111,9 @@ def test_dimensional_scaling(name):
     s = 3.7
     K2, M2 = shell_matrices(s * X, cells, 2 * E, NU, 5 * RHO, s * T)
     D = np.tile([1, 1, 1, s, s, s], len(X))
+    # bound: scaling laws exact in exact arithmetic: ~n eps relative, atol for zeros
     assert_allclose(K2, 2 * s * D[:, None] * K1 * D, rtol=1e-10, atol=1e-12 * abs(K2).max())
+    # bound: scaling laws exact in exact arithmetic: ~n eps relative, atol for zeros
     assert_allclose(M2, 5 * s**3 * D[:, None] * M1 * D, rtol=1e-10,
                     atol=1e-12 * abs(M2).max())
 
@@ -121,6 +128,7 @@ def test_invariant_to_global_rotation_and_node_numbering(name):
     Kr, Mr = shell_matrices(X @ ROT.T, cells, E, NU, RHO, T)
     atol = 1e-12 * abs(K).max()
     assert_allclose(Kr[0], Q @ K[0] @ Q.T, atol=atol)
+    # bound: rotated element: Q M Qᵀ = M(X Qᵀ) exactly, ~n eps of the largest entry
     assert_allclose(Mr[0], Q @ M[0] @ Q.T, atol=1e-12 * abs(M).max())
     # start the cycle at another node: the same element, permuted DOFs
     shift = np.roll(np.arange(n), 1)
@@ -151,6 +159,7 @@ def test_membrane_patch_test(kind):
     inner = (6 * np.arange(4, 8)[:, None] + np.arange(6)).ravel()
     outer = np.setdiff1d(np.arange(48), inner)
     solved = np.linalg.solve(Kg[np.ix_(inner, inner)], -Kg[np.ix_(inner, outer)] @ u[outer])
+    # bound: patch test: exact in the element, static solve eps·cond(K) of a small patch
     assert_allclose(solved, u[inner], atol=1e-12)
 
 
@@ -169,11 +178,13 @@ def test_build_model_assembles_shells_with_beams():
     shells = {"q": fm.ShellProperty(0.01, steel), "t": fm.ShellProperty(0.02, steel)}
     model = fm.build_model(mesh, {"edge": beam}, shells=shells)
     # total mass: ρ t A of both shell groups plus ρ A L of the beam
+    # bound: consistent mass integrated exactly: ~n eps
     assert_allclose(model.total_mass(), RHO * (0.01 * 1 + 0.02 * 1 + 0.05**2 * 1), rtol=1e-12)
     assert model.shells.cells["quad"].tolist() == [[0, 1, 2, 3]]
     assert model.shells.group["triangle"].tolist() == ["t", "t"]
     assert_allclose(model.shells.thickness["triangle"], [0.02, 0.02])
     lam = np.linalg.eigvalsh(model.K.toarray())
+    # bound: rigid eigenvalues of eigh: eps λ_max (roundoff.py)
     assert np.sum(lam < 1e-10 * lam[-1]) == 6  # one free body: beam and shells share nodes
     # without the beam, K is the sum of the element matrices (independent dense scatter)
     model = fm.build_model(_square_mesh(("quad", "triangle")), shells=shells)
@@ -184,6 +195,7 @@ def test_build_model_assembles_shells_with_beams():
         for c, k in zip(cells, Ke, strict=True):
             d = (6 * c[:, None] + np.arange(6)).ravel()
             K[np.ix_(d, d)] += k
+    # bound: assembled sums in another order: ~n eps of the largest entry
     assert_allclose(model.K.toarray(), K, rtol=0, atol=1e-12 * abs(K).max())
 
 

@@ -63,7 +63,7 @@ def test_box_example_mount_modes_below_rigid_body_bound(box_run):
     _, result = box_run
     f = result["freq_hz"][:6]
     bound = result["rigid_body_estimate_hz"]
-    # Rayleigh-Ritz on the six rigid-body motions gives upper bounds of the six lowest
+    # bound: Rayleigh-Ritz on the six rigid-body motions gives upper bounds of the six lowest
     # eigenvalues (Courant-Fischer); round-off of both solves is ~1e-10 relative.
     assert np.all(f <= bound * (1 + 1e-10))
     # the mounts (3e5/8e5 N/m) are much softer than the welded box, so the bound is
@@ -86,7 +86,7 @@ def test_box_example_writes_mixed_vtu_and_images(box_run):
 def _bore_check(mesh, bore, centre, radius):
     nodes = mesh.points[mesh.nodes_of(bore)]
     centre = mesh.points[mesh.nodes_of(centre)[0]]
-    # Gmsh places the nodes of a circle on the circle (OpenCASCADE geometry): round-off
+    # bound: Gmsh places the nodes of a circle on the circle (OpenCASCADE geometry): round-off
     assert_allclose(np.linalg.norm(nodes - centre, axis=1), radius, rtol=1e-9)
 
 
@@ -95,10 +95,12 @@ def test_welded_box_mesh_groups():
     assert mesh.n_nodes < 3000
     assert {"top_plate", "walls", "rib", "stiffeners", "bore"} <= set(mesh.cell_sets)
     assert {f"foot_{i}" for i in range(1, 5)} | {"feet", "bearing"} <= set(mesh.node_sets)
+    # bound: mesh coordinates on a plane of the geometry: ~eps of O(1) values
     assert_allclose(mesh.points[mesh.node_sets["feet"]][:, 2], 0.0, atol=1e-12)
     _bore_check(mesh, "bore", "bearing", 0.09)
     # the stiffener ring lies at z = 0.3 m on the walls and shares their nodes
     ring = mesh.nodes_of("stiffeners")
+    # bound: mesh coordinates on a plane of the geometry: ~eps of O(1) values
     assert_allclose(mesh.points[ring, 2], 0.3, atol=1e-12)
     assert np.isin(ring, mesh.nodes_of("walls")).all()
 
@@ -140,6 +142,7 @@ def test_side_wall_mesh_mixes_quads_and_triangles():
     holes = sum(_polygon_area(mesh.points[mesh.nodes_of(b)][:, [0, 2]],
                               mesh.points[mesh.nodes_of(c)[0]][[0, 2]])
                 for b, c in (("bore_1", "bearing_1"), ("bore_2", "bearing_2")))
+    # bound: consistent mass integrated exactly: ~n eps
     assert_allclose(model.total_mass(), STEEL.rho * 0.02 * (1.6 - holes), rtol=1e-12)
 
 

@@ -138,12 +138,14 @@ def test_shape_measures_of_known_elements():
     m = checks.shell_shapes(pts, "quad", np.array([[0, 1, 2, 3], [4, 5, 6, 7]]))
     np.testing.assert_allclose(m["aspect"], [1.0, 12.0])
     np.testing.assert_allclose(m["min_angle"], [90.0, 90.0])
+    # bound: a plane element has zero warping: round-off of O(1) cross products
     np.testing.assert_allclose(m["warping"], [0.0, 0.0], atol=1e-15)
     # square with corners 0 and 2 raised by h: mean plane at h/2, z0 = h/2; half mean
     # diagonal sqrt(2)/2, so warping = (h/2) / (sqrt(2)/2) = h / sqrt(2)
     h = 0.1
     warped = np.array([[0, 0, h], [1, 0, 0], [1, 1, h], [0, 1, 0]], float)
     w = checks.shell_shapes(warped, "quad", np.array([[0, 1, 2, 3]]))["warping"]
+    # bound: closed-form size of a square element: a few eps
     assert w[0] == pytest.approx(h / np.sqrt(2), rel=1e-12)
     # rhombus with a 20° corner; a triangle with a 5° corner
     a = np.radians(20.0)

@@ -146,11 +146,13 @@ def test_wavelengths_reduce_to_the_closed_forms():
     # Euler-Bernoulli: k = (ρA ω²/EI)^¼, λ = 2π/k
     w, EI, rA = 2 * math.pi * 300.0, 1e5, 20.0
     k = sizing.flexural_wavenumber(w, EI, rA)
+    # bound: the same closed form of a few operations: a few eps
     assert_allclose(2 * math.pi / k, sizing.bending_wavelength(EI, rA, w), rtol=1e-14)
     # Timoshenko: the SS beam's k = mπ/L at its exact ω is recovered
     sec = rectangle(0.02, 0.1)
     k3 = 3 * math.pi
     w3 = sizing_omega(k3, sec)
+    # bound: closed-form Timoshenko wave number: a few eps of the polynomial root
     assert_allclose(sizing.flexural_wavenumber(w3, E * sec.Iy, RHO * sec.A, RHO * sec.Iy,
                                                G * sec.Asz), k3, rtol=1e-12)
 
@@ -159,6 +161,7 @@ def test_elements_per_half_wave_meets_the_target_exactly():
     for model in (sizing.BEAM_BENDING, sizing.BEAM_LINEAR, sizing.SHELL_BENDING["quad"]):
         n = sizing.elements_per_half_wave(1e-3, model)
         u = (math.pi / n) ** 2
+        # bound: root of the error polynomial: a few eps
         assert_allclose(model.c4 * u * u + model.c2 * u, 1e-3, rtol=1e-12)
     # MITC4 at 1e-3: π sqrt(125) = 35.1 elements per half-wave
     assert_allclose(sizing.elements_per_half_wave(1e-3, sizing.SHELL_BENDING["quad"]),
@@ -301,6 +304,7 @@ def test_auto_frame_scene_reaches_its_target(target):
     err = f / ref - 1
     # measured: 1e-3 → 36 elements, largest error 7.9e-4 (mode 6 at 97.4 Hz, the top of
     # the band); 1e-4 → 108 elements, 8.8e-5
+    # bound: error >= 0 (Rayleigh-Ritz); allowance for eigensolver round-off eps λ_max/λ
     assert (err >= -1e-9).all()
     assert err.max() <= target
     assert err.max() > target / 20  # the sizing is not wasteful beyond a factor 20

@@ -79,13 +79,16 @@ def test_symmetric_semidefinite_six_rigid_modes(kind):
     assert_allclose(K, K.T, rtol=0, atol=100 * EPS * abs(K).max())
     assert_allclose(M, M.T, rtol=0, atol=100 * EPS * abs(M).max())
     lam = np.linalg.eigvalsh(K)
+    # bound: positive semi-definite K: eigh's round-off eps λ_max (roundoff.py)
     assert lam[0] > -1e-12 * lam[-1]
     # exactly six zero-energy modes: the seventh eigenvalue is far from round-off (the
     # measured gap lam7 / lam_max is > 1e-4 for all five types; a spurious mode would
     # sit at ~1e-16)
+    # bound: rigid eigenvalues of eigh: eps λ_max; the 7th is > 1e-4 λ_max
     assert np.all(np.abs(lam[:6]) < 1e-12 * lam[-1])
     assert lam[6] > 1e-5 * lam[-1]
     R = _rigid_modes(X)
+    # bound: rigid motions: K R = 0 in exact arithmetic, ~n eps of |K| |X|
     assert_allclose(K @ R, 0.0, atol=1e-11 * abs(K).max() * abs(X).max())
     assert np.linalg.eigvalsh(M)[0] > 0  # consistent mass is positive definite
 
@@ -95,7 +98,7 @@ def test_mass_is_rho_v_on_distorted_element(kind):
     X, _, M = _element(kind)
     V = _volume(kind)  # sympy, exact
     R = _rigid_modes(X)
-    # the quadrature integrates det DF exactly for these maps (degree <= 3 in total for
+    # bound: the quadrature integrates det DF exactly for these maps (degree <= 3 in total for
     # the quadratic types, trilinear-squared for Q1): round-off only
     assert_allclose(np.diag(R[:, :3].T @ M @ R[:, :3]), RHO * V, rtol=1e-12)
 
@@ -110,7 +113,7 @@ def test_constant_strain_patch(kind):
     mu = E / (2 * (1 + NU))
     lam = 2 * mu * NU / (1 - 2 * NU)
     energy = _volume(kind) * (lam * np.trace(eps) ** 2 + 2 * mu * np.sum(eps**2))
-    # exact for isoparametric elements (patch test); round-off only
+    # bound: exact for isoparametric elements (patch test); round-off only
     assert_allclose(u @ K @ u, energy, rtol=1e-11)
 
 
@@ -119,12 +122,15 @@ def test_scaling_and_frame_invariance(kind):
     _, K1, M1 = _element(kind)
     _, K2, M2 = _element(kind, scale=3.0)
     # K ∝ E L (N/m), M ∝ ρ L³ (kg)
+    # bound: scaling laws exact: ~n eps of the largest entry
     assert_allclose(K2, 3.0 * K1, rtol=0, atol=1e-12 * abs(K2).max())
     assert_allclose(M2, 27.0 * M1, rtol=0, atol=1e-12 * abs(M2).max())
     X, K0, _ = _element(kind, rotate=False)
     Q = np.kron(np.eye(len(X)), ROT)  # u_rotated = Q u
+    # bound: rotated element: Q K Qᵀ = K(X Qᵀ) exactly, ~n eps of the largest entry
     assert_allclose(Q @ K0 @ Q.T, K1, rtol=0, atol=1e-11 * abs(K1).max())
     Ke, _ = solid_matrices(X, np.arange(len(X))[None], kind, 2 * E, NU, RHO)
+    # bound: two identical elements summed: a few eps
     assert_allclose(Ke[0], 2 * K0, rtol=1e-14)
 
 
@@ -150,7 +156,9 @@ def test_node_order_is_meshio_vtk(kind):
         assert_allclose(ref[20:], [[0, .5, .5], [1, .5, .5], [.5, 0, .5], [.5, 1, .5],
                                    [.5, .5, 0], [.5, .5, 1], [.5, .5, .5]])
     N, _, W = reference_element(kind)
+    # bound: partition of unity of polynomial shape functions: ~n eps
     assert_allclose(N.sum(axis=1), 1.0, rtol=1e-13)  # partition of unity
+    # bound: quadrature weights summed: ~n eps
     assert_allclose(W.sum(), 1 / 6 if kind.startswith("tetra") else 1.0, rtol=1e-13)
     X = ref.copy()
     Ke, _ = solid_matrices(X, np.arange(len(X))[None], kind, E, NU, RHO)
@@ -181,6 +189,7 @@ def test_build_model_with_solids_and_a_beam():
     beam = fm.BeamProperty(rectangle(0.1, 0.1), steel)
     model = fm.build_model(mesh, {"arm": beam}, solids={"block": fm.SolidProperty(steel)})
     # ρ V of the two unit cubes plus ρ A L of the beam (L = 1)
+    # bound: consistent mass integrated exactly: ~n eps
     assert_allclose(model.total_mass(), RHO * (2.0 + 0.01), rtol=1e-12)
     assert model.solids.cells["hexahedron"].shape == (2, 8)
     assert model.solids.group["hexahedron"].tolist() == ["block", "block"]
@@ -221,7 +230,9 @@ def test_assembly_in_chunks_equals_dense_scatter():
     for chunk in (None, 1):
         Ks, Ms = assemble_solid(mesh.points, cells, "hexahedron", E, NU, RHO, K.shape[0],
                                 chunk=chunk)
+        # bound: assembled sums in another order: ~n eps of the largest entry
         assert_allclose(Ks.toarray(), K, rtol=0, atol=1e-13 * abs(K).max())
+        # bound: consistent mass integrated exactly: ~n eps
         assert_allclose(Ms.sum() / 3, RHO * 2.0, rtol=1e-13)  # two unit cubes
     bad = np.vstack([cells, cells[1][[4, 5, 6, 7, 0, 1, 2, 3]]])  # element 2 inverted
     with pytest.raises(ValueError, match=r"hexahedron element 2 \(nodes \[5, 10"):

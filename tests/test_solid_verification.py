@@ -71,6 +71,7 @@ L, H = 1.0, 0.05
 def _bar_frequencies(kind, n, k, n_modes=3):
     mesh = grid_solid(kind, np.linspace(0, L, n + 1), np.linspace(-H / 2, H / 2, k + 1),
                       np.linspace(-H / 2, H / 2, k + 1))
+    # bound: generated coordinates: the root face at x = 0 to ~eps
     root = np.flatnonzero(mesh.points[:, 0] < 1e-12)
     model = fm.build_model(mesh, solids={"solid": fm.SolidProperty(STEEL)},
                            supports=[fm.Support(root, "translations")])
@@ -189,6 +190,7 @@ def _stiffened_plate_solid(nx=20, ny=4):
     keep[:, :, 2] = True  # plate
     keep[:, ny, :] = True  # rib under the centre strip
     mesh = grid_solid("hexahedron27", np.linspace(0, PL, nx + 1), ys, zs, keep)
+    # bound: generated coordinates: the root face at x = 0 to ~eps
     root = np.flatnonzero(mesh.points[:, 0] < 1e-12)
     return fm.build_model(mesh, solids={"solid": fm.SolidProperty(STEEL)},
                           supports=[fm.Support(root, "translations")])
@@ -198,6 +200,7 @@ def _probe_shapes(model, shapes):
     """uy, uz at the probe points of the plate mid-plane (rows), unit norm per mode."""
     nodes = [int(np.argmin(np.linalg.norm(model.mesh.points - [x, y, 0], axis=1)))
              for x, y in PROBES]
+    # bound: probe nodes on exact grid coordinates: ~eps of O(1) values
     assert np.allclose(model.mesh.points[nodes, :2], PROBES, atol=1e-12)
     v = np.concatenate([shapes[6 * np.array(nodes) + c] for c in (1, 2)])
     return v / np.linalg.norm(v, axis=0)
@@ -228,7 +231,7 @@ def test_stiffened_plate_beam_shell_matches_solid():
     mac = (a.T @ b) ** 2
     assert np.all(np.diag(mac) > 0.95)
     assert np.all(np.argmax(mac, axis=1) == np.arange(5))
-    # the masses agree exactly: ρ (L W t + L b h) in both (no overlap of plate and rib)
+    # bound: the masses agree exactly: ρ (L W t + L b h) in both (no overlap of plate and rib)
     assert_allclose(shell.total_mass(), solid.total_mass(), rtol=1e-12)
 
 
@@ -251,10 +254,12 @@ def _post_on_block(link=None):
                              n0 + np.arange(20)])
     mesh = fm.Mesh(points, {**block.cells, "line": lines},
                    {**block.cell_sets, "post": {"line": np.arange(20)}})
+    # bound: generated coordinates: ~eps of O(0.1) values
     patch = np.flatnonzero((P[:, 2] > -1e-12) & (np.abs(P[:, :2]) <= 0.05 + 1e-12).all(1))
     links = {"rigid": {"rigid_links": [fm.RigidLink(root, patch)]},
              "interpolating": {"interpolating_links": [fm.InterpolatingLink(root, patch)]},
              None: {}}[link]
+    # bound: generated coordinates: ~eps of O(0.1) values
     return fm.build_model(mesh, {"post": fm.BeamProperty(rectangle(0.02, 0.02), STEEL)},
                           solids={"solid": fm.SolidProperty(STEEL)},
                           supports=[fm.Support(np.flatnonzero(P[:, 2] < -a + 1e-12))], **links)
@@ -276,6 +281,7 @@ def test_beam_clamped_into_solid_block_through_a_link(link):
     f_ref = fm.modes(clamped, 2).freq_hz
     f = fm.modes(_post_on_block(link), 2).freq_hz
     assert_allclose(f, f_ref, rtol=1e-3)
+    # bound: the block only adds compliance (Rayleigh); allowance eps λ_max/λ (roundoff.py)
     assert np.all(f <= f_ref * (1 + 1e-9))  # the block can only add compliance
 
 

@@ -81,10 +81,11 @@ def test_solves_agree_with_dense_and_superlu(pencil, name):
     x, X = f.solve(b), f.solve(B)
     assert x.shape == b.shape
     assert X.shape == B.shape
-    # cond(A) ~ λ_max/σ ~ 1e7 here: 1e-10 relative is round-off
+    # bound: cond(A) ~ λ_max/σ ~ 1e7 here: 1e-10 relative is round-off
     assert np.linalg.norm(x - ref[:, 0]) <= 1e-10 * np.linalg.norm(ref[:, 0])
     assert np.linalg.norm(X - ref[:, 1:]) <= 1e-10 * np.linalg.norm(ref[:, 1:])
     lu = direct.factorize(A, "superlu")
+    # bound: eps·cond(A) of a linear solve, cond ~1e7 (comment above)
     assert np.linalg.norm(x - lu.solve(b)) <= 1e-10 * np.linalg.norm(x)
 
 
@@ -104,6 +105,7 @@ def test_inertia_counts_eigenvalues_below_the_shift(pencil, name, index):
     A = (K - cut * M).tocsc()
     b = np.random.default_rng(2).standard_normal(K.shape[0])
     x = f.solve(b)
+    # bound: backward error of a stable factorisation: ~n eps ‖A‖ ‖x‖
     assert np.linalg.norm(A @ x - b) <= 1e-12 * sp.linalg.norm(A) * np.linalg.norm(x)
 
 
@@ -127,7 +129,7 @@ def test_refactor_reuses_the_analysis(pencil, name):
         A = (K - sigma * M).tocsc()
         assert f.refactor(A) is f
         fresh = direct.factorize(A, "superlu").solve(b)
-        # cond(A) <= λ_max / (0.5 λ_1) ~ 1e7: 1e-10 relative is round-off
+        # bound: cond(A) <= λ_max / (0.5 λ_1) ~ 1e7: 1e-10 relative is round-off
         assert np.linalg.norm(f.solve(b) - fresh) <= 1e-10 * np.linalg.norm(fresh)
     if name != "superlu":  # no new symbolic phase (SuperLU has none to keep)
         assert f.timings["analyse"] == analysed
@@ -135,6 +137,7 @@ def test_refactor_reuses_the_analysis(pencil, name):
     A = (K - 0.5 * (lam[4] + lam[5]) * M).tocsc()
     assert f.refactor(A).n_negative == 5
     fresh = direct.factorize(A, "superlu").solve(b)
+    # bound: eps·cond(A) of a linear solve near λ_5: cond ~1e8
     assert np.linalg.norm(f.solve(b) - fresh) <= 1e-9 * np.linalg.norm(fresh)
     with pytest.raises(ValueError, match="order"):
         f.refactor(sp.eye(3, format="csc"))
@@ -166,6 +169,7 @@ def test_pardiso_thread_settings_may_change_between_calls(pencil):
         with threadpool_limits(solve_threads):
             x = f.solve(b)
         A2 = K + 2 * M
+        # bound: backward error of a stable factorisation: ~n eps ‖A‖ ‖x‖
         assert np.linalg.norm(A2 @ x - b) <= 1e-12 * sp.linalg.norm(A2) * np.linalg.norm(x)
 
 
@@ -190,6 +194,7 @@ def test_pardiso_parallel_block_solve_equals_the_column_loop(pencil, monkeypatch
     assert f._twins == []
     with threads.limit(factor=2):
         x = f.solve(b)
+    # bound: backward error of a stable factorisation: ~n eps ‖A‖ ‖x‖
     assert np.linalg.norm(A2 @ x - b) <= 1e-12 * sp.linalg.norm(A2) * np.linalg.norm(x)
 
 
@@ -199,12 +204,13 @@ def test_pivots_give_the_determinant_and_bound_the_diagonal(pencil, name):
     A = (K + 1e-3 * lam[0] * M).tocsc()
     piv, order = direct.factorize(A, name).pivots()
     assert np.array_equal(np.sort(order), np.arange(A.shape[0]))
-    # product of the pivots = det A (numpy slogdet: dense LU), 1e-10 relative in log
+    # bound: product of the pivots = det A (numpy slogdet: dense LU), 1e-10 relative in log
     sign, logdet = np.linalg.slogdet(A.toarray())
     assert sign == 1.0
     assert abs(np.log(piv).sum() - logdet) <= 1e-10 * abs(logdet)
     # positive definite: every pivot (a Schur complement diagonal) lies in (0, A_jj]
     assert np.all(piv > 0)
+    # bound: pivots of an SPD factorisation <= A_jj in exact arithmetic: a few eps
     assert np.all(piv <= A.diagonal()[order] * (1 + 1e-12))
 
 
@@ -224,8 +230,10 @@ def test_modes_report_the_solver_and_agree_across_backends(name):
     assert (ref.method, result.method) == ("arpack", "arpack")
     assert (ref.solver, result.solver) == ("superlu", name)
     assert result.sturm_count == result.n_modes  # inertia of K - cut M from this backend
-    # both converge ARPACK to round-off of the same pencil: measured 1e-13 relative
-    assert_allclose(result.omega2, ref.omega2, rtol=1e-10)
+    # bound: both converge ARPACK to round-off of the same pencil: measured 1e-13 relative;
+    # each factorisation's backward error moves λ by eps λ_max: 10 eps λ_max/λ_1 = 3.4e-10
+    # (roundoff.py; 1e-10 lay below it)
+    assert_allclose(result.omega2, ref.omega2, rtol=1e-9)
 
 
 def test_small_models_take_cholmod_or_superlu_and_dense_has_no_solver():
@@ -341,6 +349,7 @@ def test_rigid_body_modes_span_the_null_space_of_a_free_model():
     B = lobpcg.near_nullspace(model)
     K = model.K_free
     assert B.shape == (model.n_free, 6)
+    # bound: rigid motions: K B = 0 in exact arithmetic, ~n eps ‖K‖ ‖B‖
     assert np.linalg.norm(K @ B) <= 1e-12 * sp.linalg.norm(K) * np.linalg.norm(B)
     assert np.linalg.matrix_rank(B) == 6
     assert lobpcg.node_blocksize(model.free) == 6
@@ -354,6 +363,7 @@ def solid_block():
     (2 100 free DOFs, 3 per node)."""
     mesh = grid_solid("hexahedron", np.linspace(0, 1, 21), np.linspace(0, 0.2, 5),
                       np.linspace(0, 0.3, 7))
+    # bound: generated coordinates: the root face at x = 0 to ~eps
     root = np.flatnonzero(mesh.points[:, 0] < 1e-12)
     return fm.build_model(mesh, solids={"solid": fm.SolidProperty(STEEL)},
                           supports=[fm.Support(root, "translations")])

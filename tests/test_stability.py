@@ -105,7 +105,7 @@ def test_mathieu_verdict_flips_across_each_boundary():
         assert above.stable == unstable_below, value
         growing = below if unstable_below else above
         assert growing.spectral_radius > 1.001  # ~1 + sqrt(|tr Φ| - 2) ~ 1 + 1e-2
-        # undamped Hill equation: det Φ = 1 (Liouville), μ₁ μ₂ = 1, kept by Magnus to
+        # bound: undamped Hill equation: det Φ = 1 (Liouville), μ₁ μ₂ = 1, kept by Magnus to
         # round-off (A ∈ sl(2): every step exponential has det 1)
         assert abs(np.prod(below.multipliers) - 1.0) < 1e-12
 
@@ -120,6 +120,7 @@ def test_damped_mathieu_equals_shifted_undamped():
     assert_allclose(np.sort_complex(damped.multipliers),
                     np.sort_complex(np.exp(-c * np.pi) * shifted.multipliers), rtol=1e-7)
     # Liouville: det Φ = exp(∫ tr A) = exp(-2cπ); exponents shifted by -c
+    # bound: Liouville identity, Magnus exact for det: ~n_steps eps
     assert_allclose(np.prod(damped.multipliers).real, np.exp(-2 * c * np.pi), rtol=1e-12)
     assert_allclose(np.sort(damped.exponents.real), np.sort(shifted.exponents.real) - c,
                     atol=1e-7)
@@ -140,6 +141,7 @@ def test_constant_coefficients_give_the_matrix_exponential():
                                                    -np.linalg.solve(M, B)]])
     Phi = monodromy(M, B, lambda t: np.broadcast_to(C, (t.size, n, n)), T, n_steps=64)
     expected = sla.expm(A * T)
+    # bound: constant coefficients: Magnus is exact, expm products ~n_steps eps
     assert np.abs(Phi - expected).max() < 1e-11 * np.abs(expected).max()
 
 
@@ -150,12 +152,15 @@ def test_damped_oscillator_multipliers():
     result = floquet(monodromy(1.0, 2 * zeta * omega, omega**2, T, n_steps=16), T)
     wd = omega * np.sqrt(1 - zeta**2)
     expected = np.exp((-zeta * omega + np.array([1j, -1j]) * wd) * T)
+    # bound: constant coefficients: Magnus exact, ~n_steps eps
     assert_allclose(np.sort_complex(result.multipliers), np.sort_complex(expected), rtol=1e-12)
     assert_allclose(result.spectral_radius, np.exp(-zeta * omega * T), rtol=1e-12)
     assert result.stable
     # exponents: Re λ = -ζω; Im λ = ±ω_d modulo 2π/T
+    # bound: logs of exact multipliers: ~n_steps eps
     assert_allclose(result.exponents.real, -zeta * omega, rtol=1e-12)
     shift = np.mod(np.abs(result.exponents.imag) - wd, 2 * np.pi / T)
+    # bound: imaginary parts of exact exponents, mod 2π/T: ~n_steps eps of ω
     assert min(shift[0], 2 * np.pi / T - shift[0]) < 1e-10
 
 
@@ -193,6 +198,7 @@ def test_magnus_converges_with_fourth_order():
         A = np.block([[np.zeros((2, 2)), np.eye(2)], [-X]])
         return (A @ y.reshape(4, 4)).ravel()
 
+    # bound: integrator tolerances of the DOP853 reference, not test tolerances
     ref = solve_ivp(rhs, (0, T), np.eye(4).ravel(), method="DOP853", rtol=1e-13,
                     atol=1e-14).y[:, -1].reshape(4, 4)
     steps = np.array([16, 32, 64, 128])
@@ -302,6 +308,7 @@ def test_coupled_monodromy_matches_direct_assembly(damped_cam_system):
     direct = monodromy(part(0), part(1), part(2), 2 * np.pi / Omega, n_steps=32, rtol=None,
                        breakpoints=breaks)
     fast = coupled_monodromy(system, Omega, n_steps=32, rtol=None)
+    # bound: the same step exponentials in another order: ~n eps of the products
     assert np.abs(fast - direct).max() < 1e-10 * np.abs(direct).max()
 
 

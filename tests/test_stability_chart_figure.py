@@ -52,6 +52,7 @@ def speeds_in(patches, speeds) -> np.ndarray:
     inside = np.zeros(len(speeds), dtype=bool)
     for p in patches:
         x0, x1 = x_extent(p)
+        # bound: patch extents are the speeds themselves: ~eps of O(100) values
         inside |= (speeds > x0 - 1e-9) & (speeds < x1 + 1e-9)
     return inside
 
@@ -67,6 +68,7 @@ def test_unstable_speeds_are_shaded_and_only_those():
     assert speeds_in(red, c.speeds).tolist() == unstable.tolist()
     # each patch spans its run, from the crossing of ρ = 1 + tol to the next one
     expected = unstable_intervals(c.speeds, radius, unstable, np.zeros(8, bool), TOL)
+    # bound: the same interval ends from the same interpolation: ~eps of O(100) values
     assert np.ravel([x_extent(p) for p in red]) == pytest.approx(np.ravel(expected),
                                                                  abs=1e-9)
     # by hand: ρ = 0.9 at 22.857 and 1.2 at 35.714 rad/s; ln ρ reaches ln(1 + 1e-6) at

@@ -53,7 +53,7 @@ def test_split_and_reassembled_frame_matches_full(split_frame, n_modes, residual
     assembly = assemble_parts(ses)
     f, _ = _frequencies(assembly)
     error = (f - full.freq_hz) / full.freq_hz
-    # Rayleigh-Ritz: the assembled reduced model gives upper bounds (round-off 1e-9)
+    # bound: Rayleigh-Ritz: the assembled reduced model gives upper bounds (round-off 1e-9)
     assert error.min() > -1e-9
     assert error.max() < tol
 
@@ -69,6 +69,7 @@ def test_mixed_fe_part_and_superelement(split_frame):
     assert assembly.n_dof == m0.n_free + 60 + 6 * len(cut1)
     f, result = _frequencies(assembly)
     error = (f - full.freq_hz) / full.freq_hz
+    # bound: Rayleigh-Ritz upper bounds; allowance for both solves' eps λ_max/λ (roundoff.py)
     assert error.min() > -1e-9
     assert error.max() < 4.2e-5  # as above (measured 2.8e-5)
     # recovery per part: the FE half's vector at the cut equals the superelement's
@@ -77,6 +78,7 @@ def test_mixed_fe_part_and_superelement(split_frame):
     p0, p1 = m0.mesh.points, m1.mesh.points
     for node in cut1:
         other = np.flatnonzero(np.all(np.isclose(p0, p1[node]), axis=1))[0]
+        # bound: the same interface DOFs in both parts: eigenvector round-off ~eps λ_max/gap
         assert_allclose(shape1[node], shape0[other], rtol=0, atol=1e-12)
 
 
@@ -119,10 +121,11 @@ def test_residual_vectors_on_shipped_frame(machine_frame):
     aug = superelement_modes(se, n_modes=10, model=model)
     err_plain = (plain.freq_hz - full.freq_hz[:10]) / full.freq_hz[:10]
     err_aug = (aug.freq_hz - full.freq_hz[:10]) / full.freq_hz[:10]
+    # bound: Rayleigh-Ritz upper bounds; allowance for both solves' eps λ_max/λ (roundoff.py)
     assert err_aug.min() > -1e-9  # upper bounds
     assert err_aug.max() < 1e-3  # the issue's acceptance threshold
     assert err_aug.max() < 1e-3 * err_plain.max()  # residual vectors gain > 1000x
-    # where the true error is measurable (> 5e-9; the full ARPACK solve itself is good
+    # bound: where the true error is measurable (> 5e-9; the full ARPACK solve itself is good
     # to ~1e-10 relative), the estimate tracks it within 15 % (measured ratios 0.95-1.00)
     measurable = err_aug > 5e-9
     assert measurable.sum() >= 5
@@ -140,6 +143,7 @@ def test_residual_vectors_nested_and_converging(machine_frame):
     for n in (0, 4, 10, 20):
         se = craig_bampton(model, ["feet", "motor"], n_modes=n, residual_vectors=True)
         f = superelement_modes(se, n_modes=10).freq_hz
+        # bound: Rayleigh-Ritz upper bounds; allowance for both solves' eps λ_max/λ (roundoff.py)
         assert np.all(f >= full.freq_hz[:10] * (1 - 1e-9))
         if previous is not None:
             assert np.all(f <= previous * (1 + 1e-9))

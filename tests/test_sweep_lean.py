@@ -82,6 +82,7 @@ def test_lean_path_equals_general_path(machine, n_modes, track):
     assert_array_equal(new.eigenvalues, old.eigenvalues)
     assert_array_equal(new.damping_ratio, old.damping_ratio)
     assert_array_equal(new.vectors, old.vectors)
+    # bound: the same MAC arithmetic in another order: ~n eps of O(1) values
     assert_allclose(new.mac_step, old.mac_step, rtol=0, atol=1e-12)
     assert new.form == old.form == "symmetric"
 
@@ -149,6 +150,7 @@ def test_batched_span_mac_equals_per_angle():
     out = sw._batch_span_mac(S, nx, G, split, mac)
     for j in range(k):
         expected = sw._span_mac(S[j], nx[j], G[j], sw._groups(split[j]), mac[j])
+        # bound: batched and per-angle span MAC: the same products, ~n eps of O(1) values
         assert_allclose(out[j], expected, rtol=0, atol=1e-12)
     assert (out[:, :, :3] > mac[:, :, :3] + 1e-6).any()  # the span MAC differs from the MAC
 

@@ -97,7 +97,7 @@ def test_condensed_stiffness_numbers_match_formula():
     Mu, _, Cu = ch.unit_matrices(0.4)
     D = Cu[:, None] - lam[:, None, None] * Mu[:, None]  # (units, L, 2, 2)
     exact = D[..., 0, 0] - D[..., 0, 1] ** 2 / D[..., 1, 1]
-    # modal sum against direct elimination: same numbers to round-off (~1e-12 here,
+    # bound: modal sum against direct elimination: same numbers to round-off (~1e-12 here,
     # the terms are ~1e3 times the result near μ)
     assert np.allclose(tr._unit_stiffness(fz, lam), exact, rtol=1e-10, atol=0)
 
@@ -141,16 +141,17 @@ def test_transfer_agrees_with_assembled(name, phi_deg):
     assert modes.converged.all()
     assert len(modes) == ch.n
     got = modes.omega2
+    # bound: rigid λ = 0 ± eps λ_max (roundoff.py), far below the elastic ones
     elastic = lam > 1e-9 * lam[-1]  # free-free chains: one rigid mode, λ = 0 ± round-off
     assert np.all(got[~elastic] == 0.0)
-    # bisection to rtol 1e-12 on the exact count; eigh's own error ~1e-13 relative
+    # bound: bisection to rtol 1e-12 on the exact count; eigh's own error ~1e-13 relative
     rel = np.abs(got[elastic] - lam[elastic]) / lam[elastic]
     assert rel.max() <= 1e-9
     V = modes.vectors
     M, _, C = ch.sparse_matrices(phi)
     res = (np.linalg.norm(C @ V[:, elastic] - (M @ V[:, elastic]) * got[elastic], axis=0)
            / np.linalg.norm(C @ V[:, elastic], axis=0))
-    # round-off level: |δλ|/λ ≤ 1e-12 from the bracket, inverse iteration to 1e-12
+    # bound: round-off level: |δλ|/λ ≤ 1e-12 from the bracket, inverse iteration to 1e-12
     assert res.max() <= 5e-12
     # M-orthonormal; close roots (relative gaps down to 1e-8 in the follower cluster)
     # are Rayleigh–Ritz-ed together, so the Gram matrix is I to ~1e-8
@@ -161,12 +162,14 @@ def test_assembled_modes_reference_paths():
     ch = phased(30, left=End.fixed())
     dense = assembled_modes(ch, 0.7, n_modes=12)
     band = assembled_modes(ch, 0.7, f_max=dense.freq_hz[-1] * (1 + 1e-9))
+    # bound: the same dense eigh twice (count vs band): identical to round-off, a few eps
     assert np.allclose(dense.freq_hz, band.freq_hz, rtol=1e-12)
     assert dense.vectors.shape == (ch.n, 12)
     big = phased(1100, left=End.fixed())  # n = 2199 > DENSE_MAX: sparse shift-invert
     sparse = assembled_modes(big, 0.7, n_modes=6)
     mine = transfer_modes(big, 0.7, n_modes=6, vectors=False)
     # Lanczos with residual ≤ 1e-6 relative (femmech.solve); eigenvalues converge quadratically
+    # bound: Lanczos Ritz residual 1e-12 -> eigenvalue error ~1e-24, plus eps λ_max/λ (roundoff.py)
     assert np.allclose(sparse.freq_hz, mine.freq_hz, rtol=1e-9)
 
 
@@ -197,6 +200,7 @@ def test_no_missed_root_in_a_band():
     band = (f > 95) & (f < 110)  # the crowded band around the follower frequency 100.66 Hz
     modes = transfer_modes(ch, phi, f_max=110.0, vectors=False)
     assert len(modes) == np.count_nonzero(f < 110)
+    # bound: bisection rtol 1e-12 on the roots against eigh's eps λ_max/λ (roundoff.py)
     assert np.allclose(modes.freq_hz[modes.freq_hz > 95], f[band], rtol=1e-10)
     lowest = transfer_modes(ch, phi, n_modes=7, vectors=False)
     assert np.allclose(lowest.freq_hz, f[:7], rtol=1e-10)
@@ -211,6 +215,7 @@ def test_repeated_follower_root_in_dwell():
     phi = np.radians(150.0)
     modes = transfer_modes(ch, phi, n_modes=ch.n)  # 2n − 1: the clamped node is gone
     lam = dense_eigenvalues(ch, phi)
+    # bound: bisection rtol 1e-12 against eigh's eps λ_max/λ (roundoff.py)
     assert np.allclose(modes.omega2, lam, rtol=1e-11)
     at = np.flatnonzero(np.abs(modes.omega2 / (STIFF / MASS) - 1) < 1e-12)
     assert at.size == n
@@ -218,9 +223,11 @@ def test_repeated_follower_root_in_dwell():
     V = modes.vectors[:, at]
     M, _, C = ch.sparse_matrices(phi)
     follower = ch.unit_dofs[:, 1]
+    # bound: follower-only modes: shaft components are round-off, ~n eps of M-unit vectors
     assert np.abs(V[ch.node_dof[ch.node_dof >= 0]]).max() <= 1e-12  # shaft at rest
     assert np.allclose(V.T @ (M @ V), np.eye(n), atol=1e-12)
     assert np.linalg.matrix_rank(V[follower], tol=1e-8) == n  # spans all followers
+    # bound: residual of exact eigenvectors (closed form): ~n eps ‖C V‖, n = 30
     assert np.linalg.norm(C @ V - (M @ V) * (STIFF / MASS)) <= 1e-12 * np.linalg.norm(C @ V)
 
 
@@ -249,9 +256,10 @@ def test_huge_stiffness_contrast():
                                                   + (mp.mpf(k[i]) if i < n - 1 else 0))
         exact = [float(mp.findroot(lambda x: mp.det(Cm - x * Mm), mp.mpf(lam)))
                  for lam in modes.omega2[1:]]
+    # bound: mpmath roots to 15+ digits against bisection rtol 1e-12 (transfer_modes)
     assert np.allclose(modes.omega2[1:], exact, rtol=1e-12, atol=0)
     lam = dense_eigenvalues(ch, 1.1)
-    # eigh: within its own bound, ~eps λ_max absolute
+    # bound: eigh: within its own bound, ~eps λ_max absolute
     assert np.all(np.abs(modes.omega2[1:] - lam[1:4]) <= 1e-9 * lam[1:4] + 100 * np.finfo(
         float).eps * lam[-1])
 
@@ -322,5 +330,6 @@ def test_negative_root_divergence():
     assert lam[0] < 0  # the reference agrees there is one
     modes = transfer_modes(ch, 0.3, n_modes=4)
     assert modes.freq_hz[0] < 0
+    # bound: bisection rtol 1e-12 on the roots against eigh's eps λ_max/λ (roundoff.py)
     assert np.allclose(modes.omega2, lam[:4], rtol=1e-10)
     assert count_below(ch, 0.3, 0.0) == 1

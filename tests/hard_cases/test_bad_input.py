@@ -334,6 +334,7 @@ def test_random_corruption_gives_a_clean_error_or_a_sound_model(data):
         assert_clean(exc)
         return
     K, M = model.K_free, model.M_free
+    # bound: K, M symmetric by construction: asymmetry is round-off, ~n eps of the largest entry
     assert abs(K - K.T).max() <= 1e-9 * abs(K).max()
     assert abs(M - M.T).max() <= 1e-9 * abs(M).max()
     try:

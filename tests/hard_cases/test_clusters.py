@@ -67,7 +67,7 @@ def test_every_member_of_a_repeated_eigenvalue_is_found(square_frame):
     cut = pairs[2].start + 1  # ask for a count that ends inside the third pair
     result = fm.modes(model, n_modes=cut)
     assert result.n_modes == cut + 1  # the pair is returned whole
-    assert_allclose(result.omega2, lam[:cut + 1], rtol=1e-9)  # measured 4e-12 (λ)
+    assert_allclose(result.omega2, lam[:cut + 1], rtol=1e-9)  # bound: measured 4e-12 (λ)
     free = model.free
     M = model.M_free
     for s in slices:
@@ -87,6 +87,7 @@ def test_reduced_symmetric_frame_keeps_the_pairs(square_frame):
     # CB (20 modes + residual vectors) truncation: measured 7e-8 and 1.3e-6 in λ
     assert_allclose(result.omega2[:16], lam[:16], rtol=1e-5)
     for s in cluster_slices(lam[:16], PAIR_RTOL):
+        # bound: members of an exact pair (symmetry) from one CB solve: split by eps λ_max/λ only
         assert_allclose(result.omega2[s], result.omega2[s.start], rtol=1e-9)
         assert subspace_cos2(result.shapes[model.free, s], X[:, s], model.M_free) > 1 - 1e-6
 
@@ -138,12 +139,13 @@ def test_full_coupled_model_finds_all_fifty_coincident_modes(fifty_cams):
     assert full.n > 400  # sparse shift-invert path
     lam, V = full_modes(full, 0.75 * np.pi, N_CAMS + 3)
     f = np.sqrt(lam.real) / (2 * np.pi)
-    in_cluster = np.abs(f / F_FOLLOWER - 1) < 1e-9  # round-off of a 649-DOF solve
+    in_cluster = np.abs(f / F_FOLLOWER - 1) < 1e-9  # bound: round-off of a 649-DOF solve
     assert np.count_nonzero(in_cluster) == N_CAMS
     # the cluster's span is the span of the 50 follower coordinates (unit vectors)
     followers = np.zeros((full.n, N_CAMS))
     followers[full.n_frame + np.arange(N_CAMS), np.arange(N_CAMS)] = 1.0
     M = full.matrices(0.75 * np.pi)[0]
+    # bound: Davis-Kahan: the cluster's subspace moves by eps λ_max/gap, gap ~ f_follower
     assert subspace_cos2(V[:, in_cluster].real, followers, M) > 1 - 1e-9
 
 
@@ -164,6 +166,7 @@ def test_sweep_tracks_the_cluster_as_a_subspace(fifty_cams):
         # in the dwells (90°-180°, 270°-360°) the cluster branches sit at the analytic
         # value; they are the same columns at every dwell angle (no branch swapped in)
         dwell = (phi > np.pi / 2 + 0.01) & (phi < np.pi - 0.01)
+        # bound: dwell: branches exactly at F_FOLLOWER up to eps λ_max/λ of dense LAPACK
         members = np.abs(result.freq_hz[dwell] / F_FOLLOWER - 1) < 1e-9
         assert np.all(members == members[0])
         assert members[0].sum() == min(N_CAMS, n_modes - 1)

@@ -77,7 +77,7 @@ def test_slider_crank_dead_centres_on_an_elastic_frame():
         assert np.isfinite(arr).all()
     assert not result.unstable.any()
     for a in (0, 24, 48):
-        # the crank branch at the dead centres: dense LAPACK round-off (measured 4e-16)
+        # bound: the crank branch at the dead centres: dense LAPACK round-off (measured 4e-16)
         assert np.abs(result.freq_hz[a] / F_CRANK - 1).min() < 1e-10
     # elsewhere the crank couples to the ram and the frame: its branch moves away
     assert np.abs(result.freq_hz[12] / F_CRANK - 1).min() > 1e-3
@@ -85,6 +85,7 @@ def test_slider_crank_dead_centres_on_an_elastic_frame():
     for angle in (0.0, np.pi):
         lam, _ = full_modes(full, angle, 6)
         f_full = np.sqrt(lam.real) / (2 * np.pi)
+        # bound: dense LAPACK of a 152-DOF pencil: eps λ_max/λ (roundoff.py), measured 2e-16
         assert np.abs(f_full / F_CRANK - 1).min() < 1e-9  # full model (152): measured 2e-16
         a = int(round(angle / (2 * np.pi) * 48))
         # CB (12 modes + residual vectors) vs full: measured 4e-9
@@ -149,6 +150,8 @@ def test_four_bar_near_toggle_stays_finite(margin):
             assert np.isfinite(arr).all()
         # a branch without positive real stiffness is flagged, not given a NaN frequency
         lam = result.eigenvalues
+        # bound: eigenvalues real to round-off eps|λ| of dense QZ: 1e-9 |λ| flags only true complex
+        # pairs
         assert np.all(result.unstable[(lam.real < 0) | (np.abs(lam.imag) > 1e-9 * abs(lam))])
     assert result.form == "unsymmetric"
     # measured: margin 1e-6 at Ω = 20 rad/s gives 3 (angle, branch) pairs with λ < 0 next

@@ -50,14 +50,15 @@ def test_free_free_frame_has_exactly_six_rigid_modes(subdivisions, method):
     if method == "arpack":
         assert result.sturm_count == 12  # no mode below the 12th missed
     # the zero modes span the six rigid-body motions (a subspace: any basis will do);
-    # measured 1 - cos² = 1e-15 (dense) and 4e-14 (ARPACK)
+    # bound: measured 1 - cos² = 1e-15 (dense) and 4e-14 (ARPACK)
     free = model.free
     R = rigid_fields(model.mesh.points)[free]
     assert subspace_cos2(result.shapes[free, :6], R, model.M_free) > 1 - 1e-10
-    # elastic modes: dense LAPACK on the (small) full pencil as the independent reference;
+    # bound: elastic modes: dense LAPACK on the (small) full pencil as the independent reference;
     # round-off ~ eps λ_max / λ_7 ~ 1e-10 relative (measured 3e-13, 2e-12)
     lam = sla.eigh(model.K_free.toarray(), model.M_free.toarray(), eigvals_only=True)
     assert_allclose(result.omega2[6:], lam[6:12], rtol=1e-9)
+    # bound: zeros of dense LAPACK: eps λ_max absolute (roundoff.py), far below 1e-9 λ_7
     assert np.all(np.abs(lam[:6]) < 1e-9 * lam[6])  # the reference has six zeros too
 
 
@@ -91,6 +92,7 @@ def test_rigid_by_construction_gives_six_zero_modes(build):
     assert_allclose(result.freq_hz, 0.0)
     assert result.residual.max() < 1e-6  # measured 0 and 2e-9
     # the modes are the six rigid motions (M-orthonormal basis of the whole space)
+    # bound: M-orthonormal rigid basis: ~n eps·cond(M)
     assert_allclose(result.shapes[model.free].T @ (model.M_free @ result.shapes[model.free]),
                     np.eye(6), atol=1e-12)
 
@@ -119,11 +121,13 @@ def test_reduced_free_free_shaft_keeps_six_rigid_modes(shaft, method):
     result = superelement_modes(se, n_modes=10, model=model)
     assert result.rigid.tolist() == [True] * 6 + [False] * (result.n_modes - 6)
     R = rigid_fields(model.mesh.points)
+    # bound: rigid subspace separated by λ_7: Davis-Kahan eps λ_max/λ_7 (measured 1e-14)
     assert subspace_cos2(result.shapes[:, :6], R, model.M) > 1 - 1e-10  # measured 1e-14
     # elastic modes: Rayleigh-Ritz upper bounds of the full ones (dense reference), tight
     # for Craig-Bampton with residual vectors (measured 2.4e-7), loose for Guyan on three
     # nodes (measured 2.6e-3 for the first bending pair, 0.146 for the second)
     err = np.sqrt(result.omega2[6:10] / lam[6:10]) - 1
+    # bound: Rayleigh-Ritz upper bounds; allowance for both solves' eps λ_max/λ (roundoff.py)
     assert err.min() > -1e-9
     assert err.max() < {"guyan": 0.2, "craig-bampton": 1e-6}[method]
 

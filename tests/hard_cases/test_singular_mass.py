@@ -111,6 +111,7 @@ def test_guyan_onto_massive_dofs_is_exact():
     assert np.isfinite(se.modal_omega2).all()
     result = superelement_modes(se, n_modes=8)
     err = np.sqrt(result.omega2 / ref[:8]) - 1
+    # bound: Rayleigh-Ritz upper bounds; allowance for both solves' eps λ_max/λ (roundoff.py)
     assert err.min() > -1e-9
     assert err.max() < 1e-5
 
@@ -153,7 +154,7 @@ def test_coupled_sweep_with_massless_frame_dofs_and_massless_mechanism_coordinat
     reduced, full = systems[True]
     result = sweep(reduced, phi, n_modes=8)
     expected = sweep(systems[False][0], phi, n_modes=8)
-    # the same reduced frame, roller condensed or not: round-off (measured 2e-14)
+    # bound: the same reduced frame, roller condensed or not: round-off (measured 2e-14)
     assert_allclose(result.freq_hz, expected.freq_hz, rtol=1e-9)
     assert not result.unstable.any()
     # against the unreduced coupled model (M singular in 61 of 120 coordinates):

@@ -86,9 +86,10 @@ def test_flutter_pair_is_detected_and_reported():
         # the two mechanism branches are the two lowest (frame from 144 Hz)
         order = np.argsort(result.freq_hz[i])[:2]
         got = result.eigenvalues[i, order]
-        # dense QZ round-off (measured 4e-16 relative)
+        # bound: dense QZ round-off (measured 4e-16 relative)
         assert_same_values(got, lam, rtol=1e-9)
         root = np.sqrt(lam)
+        # bound: dense QZ on a 2-DOF pencil: eps·cond relative (measured 4e-16)
         assert_allclose(np.sort(result.freq_hz[i, order]), np.sort(root.real) / (2 * np.pi),
                         rtol=1e-9)
         flutter = P > P_CRIT
@@ -115,6 +116,7 @@ def test_damping_raises_the_flutter_onset():
         s = np.concatenate([np.roots([MASS, b, MASS * v]) for v in lam])
         s = s[s.imag > 0]
         order = np.argsort(result.freq_hz[i])[:2]
+        # bound: dense QZ and np.roots of a quadratic: eps·cond (measured 2e-12)
         assert_same_values(result.eigenvalues[i, order], s, rtol=1e-9)  # measured 2e-12
         assert result.unstable[i, order].any() == (s.real.max() > 0)
     # just above the undamped onset the damping still wins; far above it does not
@@ -138,6 +140,7 @@ def test_divergence_is_flagged_not_hidden(damped):
     assert result.damping_ratio[0, k] == -1.0
     if damped:  # m s² + b s + k2 = 0: the growing real root (analytic)
         expected = (-10.0 + np.sqrt(100.0 + 4e4)) / 2
+        # bound: dense QZ against the closed-form real root: eps·cond of a 2-DOF pencil
         assert_allclose(result.eigenvalues[0, k], expected, rtol=1e-9)
     else:
         assert_allclose(result.eigenvalues[0, k], -1e4 / MASS, rtol=1e-9)

@@ -43,6 +43,7 @@ Z = np.linspace(0.0, 1.0, 400_001)  # peak on the grid within (Δz)² s'''' ~ 1e
 def test_law_ends_and_peak_values(name):
     law = motion_law(name)
     s, s1, s2, s3 = law.evaluate(Z)
+    # bound: closed-form law at z = 0: exact to a few eps
     assert s[0] == pytest.approx(0.0, abs=1e-15)
     assert s[-1] == pytest.approx(1.0, abs=1e-14)
     cv, ca, cj, rtol = PEAKS[name]
@@ -50,6 +51,7 @@ def test_law_ends_and_peak_values(name):
     assert_allclose(np.abs(s2).max(), ca, rtol=rtol)
     assert_allclose(np.abs(s3).max(), cj, rtol=max(rtol, 1e-8))
     # symmetric laws: s'(z) = s'(1 - z), peak velocity at mid-rise
+    # bound: symmetric law evaluated at z and 1 - z: round-off ~10 eps of the peak
     assert_allclose(s1, s1[::-1], atol=1e-12 * cv)
     assert_allclose(s1[Z.size // 2], cv, rtol=rtol)
 
@@ -60,6 +62,7 @@ def test_continuity_order_at_a_dwell_and_inside(name):
     k = CONTINUITY[name]
     assert law.continuity == k
     ends = np.array(law.evaluate(np.array([0.0, 1.0])))  # (4, 2): s..s''' at both ends
+    # bound: derivatives vanish at the ends by construction: ~10 eps of O(1) coefficients
     assert_allclose(ends[1:k + 1], 0.0, atol=1e-12)  # s', ..., s^(k) meet the dwell
     if k < 3:
         assert np.abs(ends[k + 1]).min() > 1.0  # s^(k+1) jumps against the dwell
@@ -74,6 +77,7 @@ def test_integral_of_the_law(name):
     for z in (0.1, 0.3, 0.55, 0.9, 1.0):
         expected, _ = quad(lambda u: float(law.evaluate(u)[0]), 0.0, z, epsabs=1e-14,
                            points=[j for j in law.joints() if j < z] or None)
+        # bound: quad to epsabs 1e-14 against the closed-form integral
         assert_allclose(law.integral(z), expected, rtol=1e-12, atol=1e-15)
 
 
@@ -95,9 +99,11 @@ def test_program_levels_and_breakpoints():
     cam = cam_program(0.03, rise=100, dwell_top=80, return_=120, dwell_bottom=60,
                       law="modified_trapezoid", return_law="3-4-5", start=20, base=0.01)
     d = np.deg2rad
+    # bound: closed-form cam at its dwells: exact to a few eps of 0.04
     assert_allclose(cam(d([20, 120, 150, 200, 320, 350, 380])),
                     [0.01, 0.04, 0.04, 0.04, 0.01, 0.01, 0.01], atol=1e-15)
     expected = [20 + 100 * f for f in (0, 1 / 8, 3 / 8, 5 / 8, 7 / 8)] + [120, 200, 320]
+    # bound: breakpoints are sums of degrees converted to radians and back: ~10 eps of 400
     assert_allclose(np.rad2deg(cam.breakpoints()), sorted(expected), atol=1e-12)
     assert cam == CamProfile.from_program(0.03, 100, 80, 120, 60, "modified_trapezoid",
                                           "polynomial_345", 20, 0.01)
@@ -148,6 +154,7 @@ def test_default_ramp_is_unchanged():
     got = ramp(t)
     for a, b in zip(got, (phi, 5.0 + 25.0 * s, Omega_dot), strict=True):
         assert np.array_equal(a, b)
+    # bound: the same law evaluated by another call path: a few eps
     assert_allclose(SpeedRamp(5.0, 30.0, 1.5, 0.3, 0.7, law=motion_law("cycloidal"))(t), got,
                     rtol=1e-14, atol=1e-12)
 
@@ -163,6 +170,7 @@ def test_ramp_with_any_law_is_consistent(name):
     assert_allclose(Omega - Omega[0], cumulative_trapezoid(Omega_dot, t, initial=0.0),
                     atol=1e-6)
     assert Omega[0] == 10.0
+    # bound: ramp end value from closed form: a few eps of 40
     assert Omega[-1] == pytest.approx(40.0, abs=1e-12)
     assert_allclose(Omega_dot.max(), 30.0 / 1.2 * PEAKS[name][0],
                     rtol=max(PEAKS[name][3], 1e-6))

@@ -53,6 +53,7 @@ def test_mechanism_sweep_equals_frozen_quasi_modes(case_1):
     reference = quasi_modes(case_1, PHI)
     assert result.freq_hz.shape == (PHI.size, 2)
     assert result.form == "symmetric"
+    # bound: dense eig of a 2x2 pencil on both sides: eps·cond (roundoff.py)
     assert_allclose(np.sort(result.freq_hz, axis=1), reference.freq_hz, rtol=1e-12)
     assert result.mac_step.min() > 0.9  # the two branches are followed smoothly
 
@@ -62,6 +63,7 @@ def test_mechanism_sweep_at_speed_and_damped(case_1):
     Omega = 60.0
     result = sweep(case_1, PHI, Omega=Omega, n_modes=2)
     reference = quasi_modes(case_1, PHI, Omega)
+    # bound: dense eig of a 2x2 pencil on both sides, with Ω terms: ~eps·cond (roundoff.py)
     assert_allclose(np.sort(result.freq_hz, axis=1), reference.freq_hz, rtol=1e-10)
     damped = sweep(case_1, PHI, Omega=Omega, n_modes=2, damped=True, keep_vectors=True)
     assert damped.form == "damped"
@@ -94,6 +96,7 @@ def test_tracking_follows_a_crossing():
     # the branch starting as the q2 mode (lower at V = 1) stays at f2 through the crossings
     lever = np.argmax(np.abs(tracked.vectors[0, 0, :]))  # the branch that moves q1
     other = 1 - lever
+    # bound: 2x2 eig against the closed-form f2: eps·cond
     assert_allclose(tracked.freq_hz[:, other], f2, rtol=1e-12)
     assert np.ptp(tracked.freq_hz[:, lever]) > 15.0  # it sweeps through f2 and back
     assert tracked.mac_step.min() > 0.999
@@ -125,6 +128,7 @@ def test_any_object_with_the_model_duck_type_sweeps():
     result = sweep(duck, PHI, n_modes=3)
     M, C = duck.M(PHI), duck.C(PHI, 0.0)
     lam = np.array([np.linalg.eigvals(np.linalg.solve(m, c)) for m, c in zip(M, C, strict=False)])
+    # bound: 2x2 eig against eigvals(M⁻¹C) of the same matrices: eps·cond
     assert_allclose(np.sort(result.freq_hz, axis=1),
                     np.sort(np.sqrt(lam.real), axis=1) / (2 * np.pi), rtol=1e-12)
 
@@ -160,6 +164,7 @@ def test_crane_sags_by_its_weight(crane, s4):
     # (seed 5.2.3.1 eq. 18: F_v = c(q1 - l1 q2), F_h = c(q1 + l2 q2)); mean sag m g/(2c)
     m_total = p["m2"] + p["m3"] + p["m5"]
     Fv, Fh = p["c"] * (q[0] - p["l1"] * q[1]), p["c"] * (q[0] + p["l2"] * q[1])
+    # bound: Newton equilibrium to ~eps of the residual; linear springs: a few eps
     assert_allclose(Fv + Fh, -m_total * p["g"], rtol=1e-12)
     assert_allclose((q[0] - p["l1"] * q[1] + q[0] + p["l2"] * q[1]) / 2,
                     -m_total * p["g"] / (2 * p["c"]), rtol=1e-12)
@@ -170,7 +175,9 @@ def test_crane_sags_by_its_weight(crane, s4):
     moment = (-p["l1"] * Fv + p["l2"] * Fh
               + p["g"] * (p["m3"] * (p["xi23"] + p["rS3"] * np.cos(beta))
                           + p["m5"] * (p["xi23"] + p["r25"] * np.cos(beta + p["alpha"]))))
+    # bound: moment balance of weight-level terms: ~10 eps of m g r
     assert abs(moment) < 1e-9 * m_total * p["g"] * p["r25"]
+    # bound: vertical load: the angle is 0 up to Newton's eps
     assert q[2] == pytest.approx(0.0, abs=1e-14)  # the load hangs vertically
 
 
@@ -189,6 +196,7 @@ def test_preloaded_spring_and_gravity_closed_form():
                      drives=(s,))
     vals = dict(m=3.0, c=2e4, g=9.81, delta0=0.01)
     x, info = static_equilibrium(second_kind(mech, vals), 0.02)
+    # bound: linear spring equilibrium: Newton converges to a few eps
     assert_allclose(x[0], 0.02 - 0.01 - 3.0 * 9.81 / 2e4, rtol=1e-13)
     assert info.iterations == 1  # linear: one Newton step
     assert_allclose(info.stiffness, [[2e4]])
@@ -203,6 +211,7 @@ def test_pendulum_under_constant_torque_closed_form():
                              Potential(-m * g * L * sympy.cos(th)), Load(T0, th)))
     vals = dict(m=2.0, g=9.81, L=0.5, T0=6.0)
     x, info = static_equilibrium(second_kind(mech, vals), None, q0=[0.1])
+    # bound: Newton on a smooth scalar equation: a few eps of the root
     assert_allclose(x[0], np.arcsin(6.0 / (2.0 * 9.81 * 0.5)), rtol=1e-12)
     assert 2 <= info.iterations <= 8  # quadratic convergence from 0.1 rad
     with pytest.raises(NumericalError, match="Newton iterations: residual"):
@@ -216,7 +225,9 @@ def test_rheolinear_operating_point_closed_form_and_nonlinear(case_1):
     q, info = static_equilibrium(case_1, PHI)
     _, U1, U2, _ = U.derivatives(PHI)
     F2, c1, c2 = CASE_1["F2"], CASE_1["c1"], CASE_1["c2"]
+    # bound: closed-form static solution, Newton to a few eps (atol for q ~ 0)
     assert_allclose(q[:, 0], -F2 * U1 / (c1 + F2 * U2), rtol=1e-12, atol=1e-18)
+    # bound: closed-form static solution, Newton to a few eps
     assert_allclose(q[:, 1], -F2 / c2, rtol=1e-12)
     assert info.converged
     assert info.iterations == 1
@@ -225,4 +236,5 @@ def test_rheolinear_operating_point_closed_form_and_nonlinear(case_1):
     nonlinear = second_kind(table_5_1_case(1), CASE_1, {"U": U})
     for phi, expected in zip(PHI[::10], q[::10], strict=True):
         x, _ = static_equilibrium(nonlinear, phi)
+        # bound: atol only for zero entries: round-off of O(1e-3) displacements
         assert_allclose(x[:2], expected, rtol=1e-5, atol=1e-12)

@@ -34,7 +34,7 @@ def test_symmetric_case_matches_closed_form_and_is_mass_normalised():
     res = quasi_modes(model, phi)  # Ω = 0: C = diag(c1 + F2 U'', c2), symmetric
     assert res.symmetric.all()
     ref = np.sqrt(_quadratic_roots(model.M(phi), model.C(phi, 0.0)).real) / (2 * np.pi)
-    # roots of a quadratic: cancellation in b² − 4ac, relative error ~ cond * eps; 1e-10
+    # bound: roots of a quadratic: cancellation in b² − 4ac, relative error ~ cond * eps; 1e-10
     assert_allclose(res.freq_hz, ref, rtol=1e-10)
     M = model.M(phi)
     gram = np.einsum("aji,ajk,akl->ail", res.modes, M, res.modes)
@@ -49,6 +49,7 @@ def test_unsymmetric_C_at_speed_uses_general_solver():
     res = quasi_modes(model, phi, Omega=W)
     assert not res.symmetric.any()  # C21 = m2 Ω² U''' ≠ C12 = 0 (Table 5.1)
     ref = _quadratic_roots(M, C)
+    # bound: roots of a quadratic, cond·eps (comment above)
     assert_allclose(res.omega_sq, ref, rtol=1e-10)
     # the right eigenvectors satisfy C v = λ M v: a backward-stable eigensolver leaves a
     # residual ~eps (‖C‖ + |λ| ‖M‖) ‖v‖ per column (LAPACK Users' Guide, §4.8); 10 times
@@ -80,9 +81,10 @@ def _load_example():
 
 def test_example_sweeps_360_degrees_and_writes_plot(tmp_path):
     result = _load_example().main(tmp_path)
-    # In the common dwell the mechanisms decouple: closed-form reference of the example's
+    # bound: In the common dwell the mechanisms decouple: closed-form reference of the example's
     # docstring (two-inertia shaft and single follower oscillators); LAPACK round-off
     assert_allclose(result["dwell_hz"], result["dwell_reference_hz"], rtol=1e-12)
+    # bound: LAPACK round-off of the dwell value, eps λ_max/λ of a small pencil
     assert np.all(result["freq_min_hz"] <= result["dwell_hz"] * (1 + 1e-12))
     assert np.all(result["freq_max_hz"] >= result["dwell_hz"] * (1 - 1e-12))
     # the cams change the follower and first shaft frequencies by several per cent
