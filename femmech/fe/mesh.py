@@ -320,14 +320,23 @@ def line_submesh(mesh: Mesh, elements) -> tuple[Mesh, np.ndarray]:
     return sub, node_ids
 
 
+QUAD8_CENTRE = np.array([-0.25, -0.25, -0.25, -0.25, 0.5, 0.5, 0.5, 0.5])
+"""Serendipity shape functions of the 8-node quad at its centre, ``N_i(0, 0)`` (8,):
+-¼ at the corners 0-3, ½ at the edge nodes 4-7 (meshio order). The centre value of any
+field of the 8-node element is ``QUAD8_CENTRE @ values``."""
+
+
 def quad8_to_quad9(mesh: Mesh) -> Mesh:
     """Mesh with each 8-node quad turned into a 9-node one (MITC9 shells take quad9).
 
     The centre node of each ``"quad8"`` cell is placed where the serendipity map puts
-    the element centre, ``x(0, 0) = ½ Σ edge nodes - ¼ Σ corners``, and appended after
-    the existing nodes, so that every node keeps its index and node sets stay valid.
-    The cells join the ``"quad9"`` cells (after any already there), and cell sets follow
-    them. A mesh without quad8 cells is returned unchanged.
+    the element centre, ``x(0, 0) = ½ Σ edge nodes - ¼ Σ corners`` (:data:`QUAD8_CENTRE`),
+    and appended after the existing nodes, so that every node keeps its index and node
+    sets stay valid. The cells join the ``"quad9"`` cells (after any already there), and
+    cell sets follow them. A mesh without quad8 cells is returned unchanged.
+    :func:`femmech.build_model` ties the motion of these centre nodes to the eight
+    others (:func:`quad8_centres`), so that the element keeps the serendipity
+    kinematics of the file's 8-node element.
 
     Parameters
     ----------
@@ -341,8 +350,7 @@ def quad8_to_quad9(mesh: Mesh) -> Mesh:
     quad8 = mesh.cells.get("quad8")
     if quad8 is None:
         return mesh
-    X = mesh.points[quad8]
-    centre = 0.5 * X[:, 4:].sum(axis=1) - 0.25 * X[:, :4].sum(axis=1)
+    centre = np.einsum("i,eij->ej", QUAD8_CENTRE, mesh.points[quad8])
     new = mesh.n_nodes + np.arange(len(quad8))
     old9 = mesh.cells.get("quad9", np.empty((0, 9), dtype=np.int64))
     cells = {k: v for k, v in mesh.cells.items() if k not in ("quad8", "quad9")}
@@ -356,3 +364,22 @@ def quad8_to_quad9(mesh: Mesh) -> Mesh:
             sets["quad9"] = np.concatenate(parts)
         cell_sets[name] = sets
     return Mesh(np.vstack([mesh.points, centre]), cells, cell_sets, mesh.node_sets)
+
+
+def quad8_centres(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
+    """Centre nodes that :func:`quad8_to_quad9` gives the quad8 cells of ``mesh``.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh before the conversion.
+
+    Returns
+    -------
+    centres : ndarray (n_quad8,), int
+        Node indices of the centre nodes in the converted mesh.
+    nodes : ndarray (n_quad8, 8), int
+        The eight nodes of each quad8 cell (meshio order), weights :data:`QUAD8_CENTRE`.
+    """
+    quad8 = mesh.cells.get("quad8", np.empty((0, 8), dtype=np.int64))
+    return mesh.n_nodes + np.arange(len(quad8)), np.asarray(quad8, dtype=np.int64)
