@@ -26,6 +26,8 @@ import femmech as fm
 from femmech.fe.constraints import EquationSet, add_interpolated_nodes, constraint_transform
 from femmech.fe.mesh import QUAD8_CENTRE
 from femmech.output.export import export_modes_vtu
+from femmech.reduction import craig_bampton
+from femmech.reduction.superelement import interface_dofs
 
 STEEL = fm.Material(E=200e9, nu=0.3, rho=7850.0)
 L, H, T_SKIN = 0.1, 0.02, 1e-4  # cantilever length, square side, skin thickness (m)
@@ -178,6 +180,19 @@ def test_links_and_supports_may_name_a_tied_skin():
     R[spider.inactive] = 0.0  # the rotations of solid-only nodes are not in the model
     # bound: the T entries are O(1) sums of a few products of O(1) terms: O(10) eps
     assert_allclose(spider.T @ R[spider.free], R, rtol=0, atol=1e-12)
+
+
+def test_a_skin_group_is_an_interface_without_its_centre_nodes():
+    skinned = _cantilever(True)
+    centre, nodes = _centres(skinned)
+    assert skinned.tied.tolist() == sorted((6 * centre[:, None] + np.arange(3)).ravel())
+    dofs = interface_dofs(skinned, "skin")
+    assert dofs.size == 6 * 21 + 3 * len(centre)  # the face nodes; the centres' rotations
+    assert not np.isin(dofs, skinned.tied).any()
+    with pytest.raises(ValueError, match=f"node {centre[0]} ux belongs to the centre node"):
+        interface_dofs(skinned, [int(centre[0])])
+    se = craig_bampton(skinned, "skin", n_modes=4)
+    assert se.n_interface == dofs.size
 
 
 def test_interpolated_nodes_skip_blocked_dofs_and_give_the_substitution():

@@ -11,10 +11,10 @@
   of A, become dependent, so the reference node stays an independent 6-DOF node that
   can serve as a superelement interface.
 
-* An interpolated node follows a fixed linear combination of other nodes, all six DOFs
-  component by component, ``u_c = Σ w_j u_j`` (the centre node that a quad8 shell gets
-  for the MITC9 element, tied to the serendipity interpolation of the eight others:
-  :func:`femmech.fe.mesh.quad8_centres`).
+* An interpolated node follows a fixed linear combination of other nodes, component
+  by component, ``u_c = Σ w_j u_j`` (the centre node that a quad8 skin on a solid face
+  gets for the MITC9 element, its translations tied to the serendipity interpolation
+  of the eight others: :func:`femmech.fe.mesh.quad8_centres`).
 
 Every constraint is a set of equations ``u_dep = G u_indep``; chains (a link whose
 master is the slave of another) are resolved by substitution. Fixed and dependent DOFs
@@ -198,9 +198,9 @@ def add_interpolated_nodes(eqs: EquationSet, n_dof: int, nodes: np.ndarray,
         :func:`add_interpolating_link`, whose patch may hold tied nodes).
     """
     comp = components(comps)
-    dep = (DOF_PER_NODE * np.asarray(nodes)[:, None] + comp).ravel()  # (6 k,)
+    dep = (DOF_PER_NODE * np.asarray(nodes)[:, None] + comp).ravel()  # (c k,)
     indep = (DOF_PER_NODE * np.asarray(parents)[:, None, :]
-             + comp[None, :, None]).reshape(dep.size, -1)  # (6 k, p)
+             + comp[None, :, None]).reshape(dep.size, -1)  # (c k, p)
     keep = ~blocked[dep]
     dep, indep = dep[keep], indep[keep]
     if dep.size:

@@ -334,9 +334,9 @@ def quad8_to_quad9(mesh: Mesh) -> Mesh:
     and appended after the existing nodes, so that every node keeps its index and node
     sets stay valid. The cells join the ``"quad9"`` cells (after any already there), and
     cell sets follow them. A mesh without quad8 cells is returned unchanged.
-    :func:`femmech.build_model` ties the motion of these centre nodes to the eight
-    others (:func:`quad8_centres`), so that the element keeps the serendipity
-    kinematics of the file's 8-node element.
+    Where the eight nodes all belong to solid elements (a skin on a solid face),
+    :func:`femmech.build_model` ties the centre node's translations to the serendipity
+    interpolation of the eight (:func:`quad8_centres`; :mod:`femmech.fe.elements.shell9`).
 
     Parameters
     ----------

@@ -153,6 +153,10 @@ class FEModel:
         The keyword arguments of :func:`build_model` besides the mesh (properties,
         masses, springs, supports, links), so that the model can be rebuilt on another
         mesh of the same groups (:func:`femmech.fe.refine.refined_model`).
+    tied : ndarray (n_tied,)
+        Translational DOFs of the centre nodes of quad8 skins on solid faces, which follow
+        the serendipity interpolation of their cells' eight nodes (dependent: not in
+        ``free``; their rows of T carry the weights; :mod:`femmech.fe.elements.shell9`).
     """
 
     mesh: Mesh
@@ -169,6 +173,7 @@ class FEModel:
     solids: SolidSet = field(default_factory=SolidSet)
     inactive: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))
     inputs: dict = field(default_factory=dict, repr=False, compare=False)
+    tied: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))
 
     def __repr__(self) -> str:
         kinds = ", ".join(f"{len(c)} {k}" for k, c in self.mesh.cells.items())
@@ -283,8 +288,9 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
         used[s] = True
         joined.extend(zip(m.tolist(), s.tolist(), strict=True))
     _check_nodes(mesh, used, joined)
-    fixed, eqs = _constraint_equations(mesh, n_dof, supports, masters, slaves, labels, spiders,
-                                       _skin_centres(centres, solid_set, mesh.n_nodes))
+    skin = _skin_centres(centres, solid_set, mesh.n_nodes)
+    fixed, eqs, tied = _constraint_equations(mesh, n_dof, supports, masters, slaves, labels,
+                                             spiders, skin)
     K = sum(solid_stiff, assemble(stiff_blocks, n_dof)).tocsr()
     M = sum(solid_mass, assemble(mass_blocks, n_dof)).tocsr()
     inactive = _inactive_rotations(solid_set, K, M, eqs)
@@ -298,7 +304,7 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
                    np.flatnonzero(inactive),
                    dict(beams=beams, masses=masses, springs=springs, supports=supports,
                         rigid_links=rigid_links, interpolating_links=interpolating_links,
-                        shells=shells, solids=solids, node_tol=node_tol))
+                        shells=shells, solids=solids, node_tol=node_tol), tied)
 
 
 def _check_arguments(mesh, beams, masses, springs, supports, rigid_links, interpolating_links,
@@ -342,9 +348,10 @@ def _lumped_blocks(mesh: Mesh, masses, springs, stiff_blocks: list, mass_blocks:
 
 
 def _constraint_equations(mesh: Mesh, n_dof: int, supports, masters, slaves, labels,
-                          spiders, centres) -> tuple[np.ndarray, EquationSet]:
-    """Mask (n_dof,) of supported DOFs and the equations of rigid links, quad8 centre
-    nodes on solid faces (``centres``: :func:`_skin_centres`) and interpolating links.
+                          spiders, centres) -> tuple[np.ndarray, EquationSet, np.ndarray]:
+    """Mask (n_dof,) of supported DOFs, the equations of rigid links, quad8 centre nodes
+    on solid faces (``centres``: :func:`_skin_centres`) and interpolating links, and the
+    tied centre DOFs (n_tied,).
 
     A centre node's translations follow the serendipity interpolation of its eight
     nodes (:func:`femmech.fe.constraints.add_interpolated_nodes`), except for the DOFs
@@ -356,21 +363,24 @@ def _constraint_equations(mesh: Mesh, n_dof: int, supports, masters, slaves, lab
         fixed |= fixed_mask(mesh.n_nodes, node_indices(mesh, item.nodes, "support"), item.dofs)
     eqs = EquationSet.empty()
     add_rigid_links(eqs, mesh.points, masters, slaves, labels)
-    substitution = None
+    substitution, tied = None, np.empty(0, dtype=np.int64)
     if len(centres[0]):
         blocked = fixed.copy()
         blocked[eqs.dependent()] = True
         roles = np.concatenate([masters, [r for r, _, _, _ in spiders]]).astype(np.int64)
         blocked[node_dofs(roles).ravel()] = True
+        before = len(eqs.owner)
         substitution = add_interpolated_nodes(eqs, n_dof, *centres, QUAD8_CENTRE,
                                               "translations", blocked,
                                               "quad8 centre node tie")
+        if len(eqs.owner) > before:
+            tied = np.sort(eqs.owner[-1][0])
     for reference, patch, weights, label in spiders:
         blocked = fixed.copy()
         blocked[eqs.dependent()] = True
         add_interpolating_link(eqs, mesh.points, reference, patch, weights, blocked, label,
                                substitution)
-    return fixed, eqs
+    return fixed, eqs, tied
 
 
 def _skin_centres(centres, solid_set: SolidSet, n_nodes: int):
@@ -380,9 +390,9 @@ def _skin_centres(centres, solid_set: SolidSet, n_nodes: int):
     ``centres``: :func:`femmech.fe.mesh.quad8_centres`. Such a centre node is held by
     nothing but the (usually thin) shell while the eight others move with the solid;
     left free, its transverse motion is a local mode of the skin alone (a steel
-    cantilever with a 0.1 mm quad8 skin on its end: modes at 5.1 and 7.0 kHz between
-    the first bending (1.6 kHz) and axial (7.3 kHz) modes of the solid, which has none
-    there). :func:`_constraint_equations` ties its translations to the serendipity
+    cantilever with a 0.1 mm quad8 skin on its end: four extra modes from 5.1 kHz,
+    between the solid's first (1.61 kHz) and second (7.30 kHz) modes).
+    :func:`_constraint_equations` ties its translations to the serendipity
     interpolation of the eight, the kinematics of the file's 8-node element; its
     rotations stay free (a skin's rotations are held by its transverse shear, local
     frequencies near ``sqrt(12 k G / ρ) / (2 π t)``, 16 MHz at t = 0.1 mm). The

@@ -72,9 +72,9 @@ the serendipity interpolation of the eight, ``u_9 = -¼ Σ corners + ½ Σ edge 
 linear constraint equations eliminated with the supports and links (``u = T u_free``,
 :mod:`femmech.fe.constraints`), so mode shapes and files show the centre's motion as
 interpolated. Its rotations stay free: tying them too restricts the MITC9 shear
-interpolation to serendipity rotations, which locks (4 x 4 simply supported plate,
-a/t = 10³: λ₁ +121 %), while the translations alone do not (λ₁ error 5.3e-3 at both
-a/t = 10³ and 10⁴); a skin's free centre rotation is held by its transverse shear,
+interpolation to serendipity rotations, which locks (regular 4 x 4 simply supported
+plate, a/t = 10³: λ₁ +121 %), while the translations alone do not (λ₁ error 5.3e-3 at
+both a/t = 10³ and 10⁴); a skin's free centre rotation is held by its transverse shear,
 near ``sqrt(12 k G / ρ) / (2 π t)`` (16 MHz for a 0.1 mm steel skin). Measured on a
 steel cantilever 0.1 x 0.02 x 0.02 m (6 x 2 x 2 hexahedron20) with a 0.1 mm quad8 skin
 on its end: before, four extra modes at 5.1, 7.0, 7.0 and 8.4 kHz among the solid's
