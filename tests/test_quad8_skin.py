@@ -13,6 +13,8 @@ mass-normalised mode φ of the solid (Rayleigh; e.g. Géradin & Rixen, Mechanica
 Vibrations, 3rd ed., section 4.7), ``δf/f = -½ φᵀ ΔM φ``.
 """
 
+import functools
+
 import meshio
 import numpy as np
 import pytest
@@ -24,7 +26,7 @@ from test_solid_verification import grid_solid
 
 import femmech as fm
 from femmech.fe.constraints import EquationSet, add_interpolated_nodes, constraint_transform
-from femmech.fe.mesh import QUAD8_CENTRE
+from femmech.fe.mesh import QUAD8_CENTRE, quad8_centres, quad8_to_quad9
 from femmech.output.export import export_modes_vtu
 from femmech.reduction import craig_bampton
 from femmech.reduction.superelement import interface_dofs
@@ -34,11 +36,12 @@ L, H, T_SKIN = 0.1, 0.02, 1e-4  # cantilever length, square side, skin thickness
 N_X, N_YZ = 6, 2  # hexahedron20 elements along and across
 
 
-def _cantilever(skin: bool, clamped: bool = True, hub: bool = False, supports=(), **links):
-    """Steel cantilever (hexahedron20), root clamped; with ``skin`` a quad8 steel skin
+def _cantilever(skin: bool, clamped: bool = True, hub: bool = False, supports=(),
+                kind="hexahedron20", **links):
+    """Steel cantilever (``kind`` solids), root clamped; with ``skin`` a quad8 steel skin
     of thickness T_SKIN on its free end face x = L (group ``"skin"``); with ``hub`` a
     last node at (L + H, 0, 0) for a link."""
-    mesh = grid_solid("hexahedron20", np.linspace(0, L, N_X + 1),
+    mesh = grid_solid(kind, np.linspace(0, L, N_X + 1),
                       *(np.linspace(-H / 2, H / 2, N_YZ + 1),) * 2)
     root = np.flatnonzero(mesh.points[:, 0] < 1e-12)
     supports = [fm.Support(root, "translations")] * clamped + list(supports)
@@ -61,10 +64,15 @@ def _cantilever(skin: bool, clamped: bool = True, hub: bool = False, supports=()
                           supports=supports, **links)
 
 
+@functools.cache
+def _pair(kind="hexahedron20"):
+    solid, skinned = _cantilever(False, kind=kind), _cantilever(True, kind=kind)
+    return solid, skinned, fm.modes(solid, 8), fm.modes(skinned, 8)
+
+
 @pytest.fixture(scope="module")
 def cantilevers():
-    solid, skinned = _cantilever(False), _cantilever(True)
-    return solid, skinned, fm.modes(solid, 8), fm.modes(skinned, 8)
+    return _pair()
 
 
 def _padded(A, n):
@@ -78,12 +86,18 @@ def _centres(model):
     return cells[:, 8], cells[:, :8]
 
 
-def test_skin_on_a_solid_face_adds_no_modes_and_only_its_mass(cantilevers):
-    solid, skinned, f_solid, f_skin = cantilevers
+@pytest.mark.parametrize("kind", ["hexahedron20", "hexahedron27"])
+def test_skin_on_a_solid_face_adds_no_modes_and_only_its_mass(kind):
+    solid, skinned, f_solid, f_skin = _pair(kind)
     # the skin's mass is t / L = 1e-3 of the solid's: it lowers the solid's modes by
-    # about that much and has no modes of its own in the band. Before the centre nodes
-    # were tied: 1607.1, 1607.1, 5097.1, 6957.9, 6957.9, 7291.3 Hz against the solid's
-    # 1610.2, 1610.2, 7298.7, 8700.4, 8700.4, 12721.9 Hz (four extra skin modes).
+    # about that much and has no modes of its own in the band. hexahedron20, before the
+    # centre nodes were tied: 1607.1, 1607.1, 5097.1, 6957.9, 6957.9, 7291.3 Hz against
+    # the solid's 1610.2, 1610.2, 7298.7, 8700.4, 8700.4, 12721.9 Hz (four extra skin
+    # modes). hexahedron27: the face centres are the skin's centre nodes (before: an
+    # added node at each, "nodes coincide" and no model).
+    if kind == "hexahedron27":
+        assert skinned.mesh.n_nodes == solid.mesh.n_nodes
+        assert skinned.tied.size == 0
     assert_allclose(skinned.total_mass() / solid.total_mass() - 1, T_SKIN / L, rtol=1e-6)
     n = 6  # bending pair, torsion, second bending pair, axial (the 7th/8th: 3rd pair)
     top = f_solid.freq_hz[n - 1]
@@ -94,6 +108,8 @@ def test_skin_on_a_solid_face_adds_no_modes_and_only_its_mass(cantilevers):
     phi = np.zeros((skinned.n_dof, n))
     phi[:solid.n_dof] = f_solid.shapes[:, :n]
     centre, nodes = _centres(skinned)
+    added = centre >= solid.mesh.n_nodes
+    centre, nodes = centre[added], nodes[added]
     for d in range(3):
         phi[6 * centre + d] = np.einsum("i,eik->ek", QUAD8_CENTRE, phi[6 * nodes + d])
     dM = skinned.M - _padded(solid.M, skinned.n_dof)
@@ -211,3 +227,24 @@ def test_interpolated_nodes_skip_blocked_dofs_and_give_the_substitution():
     assert full[20] == 0.25 * u[2] + 0.25 * u[8] + 0.5 * u[14]
     assert_allclose((S @ u)[[18, 19, 20]], [full[18], u[19], full[20]])
     assert_allclose(np.delete(S @ u, [18, 20]), np.delete(u, [18, 20]))
+
+
+def test_quad8_to_quad9_reuses_a_node_at_the_centre_and_shares_stacked_centres():
+    X8 = np.array([[0, 0, 0], [2, 0, 0], [2, 1, 0], [0, 1, 0], [1, 0, 0], [2, 0.5, 0],
+                   [1, 1, 0], [0, 0.5, 0]], dtype=float)
+    points = np.vstack([X8, [[1.0, 0.5, 0.0], [5.0, 5.0, 5.0]]])  # node 8 at the centre
+    cells = np.array([np.arange(8), [1, 2, 3, 0, 5, 6, 7, 4]])  # one cell twice (stacked)
+    mesh = fm.Mesh(points, {"quad8": cells})
+    out = quad8_to_quad9(mesh)
+    assert out.n_nodes == mesh.n_nodes
+    assert out.cells["quad9"][:, 8].tolist() == [8, 8]
+    assert quad8_centres(mesh)[0].size == 0
+    # without the node there: one added centre for both cells, tied to the first's nodes
+    mesh = fm.Mesh(points[[0, 1, 2, 3, 4, 5, 6, 7, 9]], {"quad8": cells})
+    out = quad8_to_quad9(mesh)
+    assert out.n_nodes == mesh.n_nodes + 1
+    assert out.cells["quad9"][:, 8].tolist() == [9, 9]
+    centres, nodes = quad8_centres(mesh)
+    assert centres.tolist() == [9]
+    assert nodes.tolist() == [list(range(8))]
+    assert_allclose(out.points[9], [1.0, 0.5, 0.0])

@@ -81,6 +81,9 @@ on its end: before, four extra modes at 5.1, 7.0, 7.0 and 8.4 kHz among the soli
 1.61 (bending), 7.30 (torsion), 8.70 (bending) and 12.7 kHz (axial); now the solid's
 modes only, each lowered by the skin's mass (1e-3 of the solid's) by 1.0e-3 … 2.0e-3,
 as the first-order mass perturbation predicts within 0.6 % (tests/test_quad8_skin.py).
+Where a node is already at the centre (the face centre of a ``hexahedron27`` under the
+skin), it is the centre node and nothing is tied: the solid holds it (before, the added
+node coincided with it and ``build_model`` refused the mesh).
 
 Stage 2 (fe): imports fe.elements.registry and the shared helpers of fe.elements.shell;
 arrays in, element matrices out.
