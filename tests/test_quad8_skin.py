@@ -7,10 +7,10 @@ was a local mode of the skin alone. ``build_model`` ties the translations of suc
 centre nodes to the serendipity interpolation of the eight (``-¼ Σ corners + ½ Σ edge
 nodes``); the centre nodes of free quad8 shells stay MITC9 centre nodes.
 
-References: the solid without the skin (the same hexahedron20 mesh), and the first-order
-eigenvalue perturbation of adding the skin's mass, ``δω²/ω² = -φᵀ ΔM φ`` for a
-mass-normalised mode φ of the solid (Rayleigh; e.g. Géradin & Rixen, Mechanical
-Vibrations, 3rd ed., section 4.7), ``δf/f = -½ φᵀ ΔM φ``.
+References: the solid without the skin (the same hexahedron20 or hexahedron27 mesh),
+and the first-order eigenvalue perturbation of adding the skin's mass,
+``δω²/ω² = -φᵀ ΔM φ`` for a mass-normalised mode φ of the solid (Rayleigh; e.g.
+Géradin & Rixen, Mechanical Vibrations), ``δf/f = -½ φᵀ ΔM φ``.
 """
 
 import functools
@@ -202,7 +202,7 @@ def test_links_and_supports_may_name_a_tied_skin():
 
 def test_a_skin_group_is_an_interface_without_its_centre_nodes():
     skinned = _cantilever(True)
-    centre, nodes = _centres(skinned)
+    centre, _ = _centres(skinned)
     assert skinned.tied.tolist() == sorted((6 * centre[:, None] + np.arange(3)).ravel())
     dofs = interface_dofs(skinned, "skin")
     assert dofs.size == 6 * 21 + 3 * len(centre)  # the face nodes; the centres' rotations
