@@ -234,8 +234,8 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
         :mod:`femmech.fe.elements.shell`, sharing nodes and DOFs with beams); every such
         cell needs exactly one. quad9 and quad8 cells are MITC9 shells
         (:mod:`femmech.fe.elements.shell9`); each quad8 cell gets a centre node
-        (:func:`femmech.fe.mesh.quad8_to_quad9`), appended after the mesh's nodes, and
-        the model's mesh is the converted one. On a quad8 cell whose eight nodes all
+        (:func:`femmech.fe.mesh.quad8_to_quad9`), appended after the mesh's nodes (or
+        the node already at its centre), and the model's mesh is the converted one. On a quad8 cell whose eight nodes all
         belong to solid elements (a skin on a solid face) the centre node's
         translations follow the serendipity interpolation of the eight (constraint
         equations in ``T``; :mod:`femmech.fe.elements.shell9`, "quad8 meshes").
