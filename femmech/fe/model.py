@@ -235,10 +235,11 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
         cell needs exactly one. quad9 and quad8 cells are MITC9 shells
         (:mod:`femmech.fe.elements.shell9`); each quad8 cell gets a centre node
         (:func:`femmech.fe.mesh.quad8_to_quad9`), appended after the mesh's nodes (or
-        the node already at its centre), and the model's mesh is the converted one. On a quad8 cell whose eight nodes all
-        belong to solid elements (a skin on a solid face) the centre node's
-        translations follow the serendipity interpolation of the eight (constraint
-        equations in ``T``; :mod:`femmech.fe.elements.shell9`, "quad8 meshes").
+        the node already at its centre), and the model's mesh is the converted one. On
+        a quad8 cell whose eight nodes all belong to solid elements (a skin on a solid
+        face) an added centre node's translations follow the serendipity interpolation
+        of the eight (constraint equations in ``T``, :attr:`FEModel.tied`;
+        :mod:`femmech.fe.elements.shell9`, "quad8 meshes").
     solids : dict[str, SolidProperty], optional
         Cell-set name → property of its tetra, tetra10, hexahedron, hexahedron20 and
         hexahedron27 cells (:mod:`femmech.fe.elements.solid`, translations only); every such
