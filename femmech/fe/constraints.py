@@ -11,6 +11,11 @@
   of A, become dependent, so the reference node stays an independent 6-DOF node that
   can serve as a superelement interface.
 
+* An interpolated node follows a fixed linear combination of other nodes, component
+  by component, ``u_c = Σ w_j u_j`` (the centre node that a quad8 skin on a solid face
+  gets for the MITC9 element, its translations tied to the serendipity interpolation
+  of the eight others: :func:`femmech.fe.mesh.quad8_centres`).
+
 Every constraint is a set of equations ``u_dep = G u_indep``; chains (a link whose
 master is the slave of another) are resolved by substitution. Fixed and dependent DOFs
 are removed; the reduced matrices are ``Tᵀ K T`` and ``Tᵀ M T``, with no penalty
@@ -159,18 +164,79 @@ def add_rigid_links(eqs: EquationSet, points: np.ndarray, masters, slaves, label
         eqs.add(DOF_PER_NODE * s + np.arange(6), DOF_PER_NODE * m + np.arange(6), g, label)
 
 
+def add_interpolated_nodes(eqs: EquationSet, n_dof: int, nodes: np.ndarray,
+                           parents: np.ndarray, weights: np.ndarray, comps,
+                           blocked: np.ndarray, label: str) -> sp.csr_matrix:
+    """Equations ``u_d[nodes[i]] = Σ_j weights[j] u_d[parents[i, j]]``, d in ``comps``.
+
+    Vectorised over the nodes; each component d is tied to the same component of the
+    parents. DOFs marked in ``blocked`` (n_dof,) are left out (fixed, already
+    dependent, or the reference or master of a link: they keep their own equation).
+
+    Parameters
+    ----------
+    eqs : EquationSet
+        Appended to in place.
+    n_dof : int
+    nodes : ndarray (k,), int
+        The interpolated nodes.
+    parents : ndarray (k, p), int
+        The nodes each one follows.
+    weights : ndarray (p,)
+        Interpolation weights (e.g. shape functions at the node's natural coordinates).
+    comps : str or sequence
+        The tied components, see :func:`femmech.fe.dofs.components`.
+    blocked : ndarray (n_dof,), bool
+    label : str
+        Names the constraint in error messages.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix (n_dof, n_dof)
+        The substitution ``u = S u`` that these equations define: identity rows for the
+        DOFs they leave alone, the weights for the tied ones (for
+        :func:`add_interpolating_link`, whose patch may hold tied nodes).
+    """
+    comp = components(comps)
+    dep = (DOF_PER_NODE * np.asarray(nodes)[:, None] + comp).ravel()  # (c k,)
+    indep = (DOF_PER_NODE * np.asarray(parents)[:, None, :]
+             + comp[None, :, None]).reshape(dep.size, -1)  # (c k, p)
+    keep = ~blocked[dep]
+    dep, indep = dep[keep], indep[keep]
+    if dep.size:
+        eqs.rows.append(np.repeat(dep, indep.shape[1]))
+        eqs.cols.append(indep.ravel())
+        eqs.vals.append(np.tile(np.asarray(weights, dtype=float), dep.size))
+        eqs.owner.append((dep, label))
+    rest = np.setdiff1d(np.arange(n_dof), dep)
+    rows = np.concatenate([rest, np.repeat(dep, indep.shape[1])])
+    cols = np.concatenate([rest, indep.ravel()])
+    vals = np.concatenate([np.ones(rest.size), np.tile(np.asarray(weights, dtype=float),
+                                                       dep.size)])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n_dof, n_dof))
+
+
 def add_interpolating_link(eqs: EquationSet, points: np.ndarray, reference: int,
-                           patch: np.ndarray, weights, blocked: np.ndarray, label: str) -> None:
+                           patch: np.ndarray, weights, blocked: np.ndarray, label: str,
+                           substitution: sp.spmatrix | None = None) -> None:
     """Equations of one RBE3-like link: six patch translations become dependent.
 
     ``blocked`` (n_dof,) marks DOFs that cannot be made dependent (fixed, or already
     dependent); the six are picked among the others by column-pivoted QR of A.
+    ``substitution`` (n_dof, n_dof), from :func:`add_interpolated_nodes`: patch DOFs that
+    are interpolated from other nodes enter through those nodes (``A`` becomes ``A S``),
+    so that the link does not lean on a DOF that depends on its own dependent ones (a
+    cycle). The patch's fit, and so the link, is the same.
     """
     try:
         A = interpolation_matrix(points[reference], points[patch], weights)
     except ValueError as exc:
         raise ValueError(f"{label}: {exc}") from None
     patch_dofs = (DOF_PER_NODE * patch[:, None] + np.arange(3)).ravel()
+    if substitution is not None:
+        S = sp.csr_matrix(substitution)[patch_dofs].tocsc()
+        patch_dofs = np.flatnonzero(np.diff(S.indptr))  # the DOFs the patch rests on
+        A = np.asarray((S[:, patch_dofs].T @ A.T).T)
     candidates = np.flatnonzero(~blocked[patch_dofs])
     if candidates.size < 6:
         raise ValueError(f"{label}: fewer than six patch DOFs are free to carry the link")

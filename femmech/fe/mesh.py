@@ -369,14 +369,32 @@ def line_submesh(mesh: Mesh, elements) -> tuple[Mesh, np.ndarray]:
     return sub, node_ids
 
 
+QUAD8_CENTRE = np.array([-0.25, -0.25, -0.25, -0.25, 0.5, 0.5, 0.5, 0.5])
+"""Serendipity shape functions of the 8-node quad at its centre, ``N_i(0, 0)`` (8,):
+-¼ at the corners 0-3, ½ at the edge nodes 4-7 (meshio order). The centre value of any
+field of the 8-node element is ``QUAD8_CENTRE @ values``."""
+
+
+CENTRE_TOL = 1e-9
+"""A node within this fraction of the model size (largest bounding-box side) of a quad8
+cell's centre is its centre node (the distance at which ``build_model`` reports nodes
+as coincident)."""
+
+
 def quad8_to_quad9(mesh: Mesh) -> Mesh:
     """Mesh with each 8-node quad turned into a 9-node one (MITC9 shells take quad9).
 
     The centre node of each ``"quad8"`` cell is placed where the serendipity map puts
-    the element centre, ``x(0, 0) = ½ Σ edge nodes - ¼ Σ corners``, and appended after
-    the existing nodes, so that every node keeps its index and node sets stay valid.
-    The cells join the ``"quad9"`` cells (after any already there), and cell sets follow
-    them. A mesh without quad8 cells is returned unchanged.
+    the element centre, ``x(0, 0) = ½ Σ edge nodes - ¼ Σ corners`` (:data:`QUAD8_CENTRE`),
+    and appended after the existing nodes, so that every node keeps its index and node
+    sets stay valid. A node of the mesh already there (within :data:`CENTRE_TOL` times
+    the model size: the face centre of a ``hexahedron27`` under a skin) is the centre
+    node instead, and cells on the same eight nodes (stacked skins) share one. The
+    cells join the ``"quad9"`` cells (after any already there), and cell sets follow
+    them. A mesh without quad8 cells is returned unchanged. Where the eight nodes all
+    belong to solid elements (a skin on a solid face), :func:`femmech.build_model` ties
+    an added centre node's translations to the serendipity interpolation of the eight
+    (:func:`quad8_centres`; :mod:`femmech.fe.elements.shell9`).
 
     Parameters
     ----------
@@ -385,14 +403,12 @@ def quad8_to_quad9(mesh: Mesh) -> Mesh:
     Returns
     -------
     Mesh
-        ``mesh.n_nodes + n_quad8`` nodes; no ``"quad8"`` cells.
+        ``mesh.n_nodes + n_added`` nodes (``n_added <= n_quad8``); no ``"quad8"`` cells.
     """
     quad8 = mesh.cells.get("quad8")
     if quad8 is None:
         return mesh
-    X = mesh.points[quad8]
-    centre = 0.5 * X[:, 4:].sum(axis=1) - 0.25 * X[:, :4].sum(axis=1)
-    new = mesh.n_nodes + np.arange(len(quad8))
+    new, centre, _ = _quad8_centre_nodes(mesh)
     old9 = mesh.cells.get("quad9", np.empty((0, 9), dtype=np.int64))
     cells = {k: v for k, v in mesh.cells.items() if k not in ("quad8", "quad9")}
     cells["quad9"] = np.vstack([old9, np.column_stack([quad8, new])])
@@ -405,3 +421,47 @@ def quad8_to_quad9(mesh: Mesh) -> Mesh:
             sets["quad9"] = np.concatenate(parts)
         cell_sets[name] = sets
     return Mesh(np.vstack([mesh.points, centre]), cells, cell_sets, mesh.node_sets)
+
+
+def quad8_centres(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
+    """Centre nodes that :func:`quad8_to_quad9` adds for the quad8 cells of ``mesh``.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh before the conversion.
+
+    Returns
+    -------
+    centres : ndarray (n_added,), int
+        Node indices of the added centre nodes in the converted mesh (not those that
+        were already nodes of ``mesh``).
+    nodes : ndarray (n_added, 8), int
+        The eight nodes of the quad8 cell of each (meshio order), the nodes of the
+        weights :data:`QUAD8_CENTRE`.
+    """
+    if "quad8" not in mesh.cells:
+        return np.empty(0, dtype=np.int64), np.empty((0, 8), dtype=np.int64)
+    _, centre, cells = _quad8_centre_nodes(mesh)
+    return mesh.n_nodes + np.arange(len(centre)), mesh.cells["quad8"][cells]
+
+
+def _quad8_centre_nodes(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Centre node of each quad8 cell (n_quad8,) in the converted mesh, the added centre
+    points (n_added, 3), m, and for each the first quad8 cell that has it (n_added,)."""
+    quad8 = np.asarray(mesh.cells["quad8"], dtype=np.int64)
+    if not len(quad8):
+        return np.empty(0, dtype=np.int64), np.empty((0, 3)), np.empty(0, dtype=np.int64)
+    _, first, inverse = np.unique(np.sort(quad8, axis=1), axis=0, return_index=True,
+                                  return_inverse=True)
+    order = np.argsort(first)  # distinct cells in the order of their first appearance
+    rank = np.empty_like(order)
+    rank[order] = np.arange(order.size)
+    first, inverse = first[order], rank[inverse.ravel()]
+    centre = np.einsum("i,eij->ej", QUAD8_CENTRE, mesh.points[quad8[first]])
+    scale = max(float(np.ptp(mesh.points, axis=0).max()), 1e-300)
+    dist, near = cKDTree(mesh.points).query(centre)
+    there = dist <= CENTRE_TOL * scale
+    index = np.where(there, near, 0)
+    index[~there] = mesh.n_nodes + np.arange(np.count_nonzero(~there))
+    return index[inverse], centre[~there], first[~there]

@@ -24,6 +24,7 @@ from femmech.fe.constraints import (
     InterpolatingLink,
     RigidLink,
     Support,
+    add_interpolated_nodes,
     add_interpolating_link,
     add_rigid_links,
     constraint_transform,
@@ -34,7 +35,7 @@ from femmech.fe.elements.beam import beam_matrices, local_frames
 from femmech.fe.elements.registry import kinds
 from femmech.fe.lumped import PointMass, Spring
 from femmech.fe.materials import Material
-from femmech.fe.mesh import Mesh, quad8_to_quad9
+from femmech.fe.mesh import QUAD8_CENTRE, Mesh, quad8_centres, quad8_to_quad9
 from femmech.fe.parts import (
     ShellProperty,
     ShellSet,
@@ -152,6 +153,10 @@ class FEModel:
         The keyword arguments of :func:`build_model` besides the mesh (properties,
         masses, springs, supports, links), so that the model can be rebuilt on another
         mesh of the same groups (:func:`femmech.fe.refine.refined_model`).
+    tied : ndarray (n_tied,)
+        Translational DOFs of the centre nodes of quad8 skins on solid faces, which follow
+        the serendipity interpolation of their cells' eight nodes (dependent: not in
+        ``free``; their rows of T carry the weights; :mod:`femmech.fe.elements.shell9`).
     """
 
     mesh: Mesh
@@ -168,6 +173,7 @@ class FEModel:
     solids: SolidSet = field(default_factory=SolidSet)
     inactive: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))
     inputs: dict = field(default_factory=dict, repr=False, compare=False)
+    tied: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))
 
     def __repr__(self) -> str:
         kinds = ", ".join(f"{len(c)} {k}" for k, c in self.mesh.cells.items())
@@ -228,8 +234,12 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
         :mod:`femmech.fe.elements.shell`, sharing nodes and DOFs with beams); every such
         cell needs exactly one. quad9 and quad8 cells are MITC9 shells
         (:mod:`femmech.fe.elements.shell9`); each quad8 cell gets a centre node
-        (:func:`femmech.fe.mesh.quad8_to_quad9`), appended after the mesh's nodes, and
-        the model's mesh is the converted one.
+        (:func:`femmech.fe.mesh.quad8_to_quad9`), appended after the mesh's nodes (or
+        the node already at its centre), and the model's mesh is the converted one. On
+        a quad8 cell whose eight nodes all belong to solid elements (a skin on a solid
+        face) an added centre node's translations follow the serendipity interpolation
+        of the eight (constraint equations in ``T``, :attr:`FEModel.tied`;
+        :mod:`femmech.fe.elements.shell9`, "quad8 meshes").
     solids : dict[str, SolidProperty], optional
         Cell-set name → property of its tetra, tetra10, hexahedron, hexahedron20 and
         hexahedron27 cells (:mod:`femmech.fe.elements.solid`, translations only); every such
@@ -259,6 +269,7 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
     solids = {} if solids is None else solids
     _check_arguments(mesh, beams, masses, springs, supports, rigid_links, interpolating_links,
                      shells, solids)
+    centres = quad8_centres(mesh)
     mesh = quad8_to_quad9(mesh)  # MITC9 shells: quad8 cells get their centre nodes
     beam_set, Ke, Me, edofs = _beam_blocks(mesh, beams, bool(shells), bool(solids))
     shell_set, shell_stiff, shell_mass = shell_blocks(mesh, shells)
@@ -278,7 +289,9 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
         used[s] = True
         joined.extend(zip(m.tolist(), s.tolist(), strict=True))
     _check_nodes(mesh, used, joined)
-    fixed, eqs = _constraint_equations(mesh, n_dof, supports, masters, slaves, labels, spiders)
+    skin = _skin_centres(centres, solid_set, mesh.n_nodes)
+    fixed, eqs, tied = _constraint_equations(mesh, n_dof, supports, masters, slaves, labels,
+                                             spiders, skin)
     K = sum(solid_stiff, assemble(stiff_blocks, n_dof)).tocsr()
     M = sum(solid_mass, assemble(mass_blocks, n_dof)).tocsr()
     inactive = _inactive_rotations(solid_set, K, M, eqs)
@@ -292,7 +305,7 @@ def build_model(mesh: Mesh, beams: dict[str, BeamProperty] | None = None, masses
                    np.flatnonzero(inactive),
                    dict(beams=beams, masses=masses, springs=springs, supports=supports,
                         rigid_links=rigid_links, interpolating_links=interpolating_links,
-                        shells=shells, solids=solids, node_tol=node_tol))
+                        shells=shells, solids=solids, node_tol=node_tol), tied)
 
 
 def _check_arguments(mesh, beams, masses, springs, supports, rigid_links, interpolating_links,
@@ -336,18 +349,66 @@ def _lumped_blocks(mesh: Mesh, masses, springs, stiff_blocks: list, mass_blocks:
 
 
 def _constraint_equations(mesh: Mesh, n_dof: int, supports, masters, slaves, labels,
-                          spiders) -> tuple[np.ndarray, EquationSet]:
-    """Mask (n_dof,) of supported DOFs and the equations of rigid and interpolating links."""
+                          spiders, centres) -> tuple[np.ndarray, EquationSet, np.ndarray]:
+    """Mask (n_dof,) of supported DOFs, the equations of rigid links, quad8 centre nodes
+    on solid faces (``centres``: :func:`_skin_centres`) and interpolating links, and the
+    tied centre DOFs (n_tied,).
+
+    A centre node's translations follow the serendipity interpolation of its eight
+    nodes (:func:`femmech.fe.constraints.add_interpolated_nodes`), except for the DOFs
+    that a support fixes, a rigid link makes dependent or a link uses as its master or
+    reference: these keep that role.
+    """
     fixed = np.zeros(n_dof, dtype=bool)
     for item in supports:
         fixed |= fixed_mask(mesh.n_nodes, node_indices(mesh, item.nodes, "support"), item.dofs)
     eqs = EquationSet.empty()
     add_rigid_links(eqs, mesh.points, masters, slaves, labels)
+    substitution, tied = None, np.empty(0, dtype=np.int64)
+    if len(centres[0]):
+        blocked = fixed.copy()
+        blocked[eqs.dependent()] = True
+        roles = np.concatenate([masters, [r for r, _, _, _ in spiders]]).astype(np.int64)
+        blocked[node_dofs(roles).ravel()] = True
+        before = len(eqs.owner)
+        substitution = add_interpolated_nodes(eqs, n_dof, *centres, QUAD8_CENTRE,
+                                              "translations", blocked,
+                                              "quad8 centre node tie")
+        if len(eqs.owner) > before:
+            tied = np.sort(eqs.owner[-1][0])
     for reference, patch, weights, label in spiders:
         blocked = fixed.copy()
         blocked[eqs.dependent()] = True
-        add_interpolating_link(eqs, mesh.points, reference, patch, weights, blocked, label)
-    return fixed, eqs
+        add_interpolating_link(eqs, mesh.points, reference, patch, weights, blocked, label,
+                               substitution)
+    return fixed, eqs, tied
+
+
+def _skin_centres(centres, solid_set: SolidSet, n_nodes: int):
+    """The quad8 centre nodes (and their eight nodes) of the quad8 cells whose eight
+    nodes all belong to solid elements: skins and coatings on a solid face.
+
+    ``centres``: :func:`femmech.fe.mesh.quad8_centres`. Such a centre node is held by
+    nothing but the (usually thin) shell while the eight others move with the solid;
+    left free, its transverse motion is a local mode of the skin alone (a steel
+    cantilever with a 0.1 mm quad8 skin on its end: four extra modes from 5.1 kHz,
+    between the solid's first (1.61 kHz) and second (7.30 kHz) modes).
+    :func:`_constraint_equations` ties its translations to the serendipity
+    interpolation of the eight, the kinematics of the file's 8-node element; its
+    rotations stay free (a skin's rotations are held by its transverse shear, local
+    frequencies near ``sqrt(12 k G / ρ) / (2 π t)``, 16 MHz at t = 0.1 mm). The
+    centre nodes of other quad8 shells stay MITC9 centre nodes: a free shell has no
+    such local mode, and the 9-node element is the more accurate (module docstring of
+    :mod:`femmech.fe.elements.shell9`).
+    """
+    nodes, parents = centres
+    if not len(nodes) or not solid_set.cells:
+        return nodes[:0], parents[:0]
+    solid = np.zeros(n_nodes, dtype=bool)
+    for cells in solid_set.cells.values():
+        solid[cells.ravel()] = True
+    on_face = solid[parents].all(axis=1)
+    return nodes[on_face], parents[on_face]
 
 
 def _inactive_rotations(solid_set: SolidSet, K, M, eqs: EquationSet) -> np.ndarray:

@@ -211,6 +211,9 @@ def interface_dofs(model: FEModel, interface) -> np.ndarray:
         node, or the components ``"all"``) means the active ones: a node that only solid
         elements use has translations only (its rotations are
         :attr:`~femmech.fe.model.FEModel.inactive`), so its three translations are taken.
+        A group leaves out the translations of the centre nodes of quad8 skins on solid
+        faces (:attr:`~femmech.fe.model.FEModel.tied`): they follow the cells' other
+        nodes, which a cell set holds too.
 
     Returns
     -------
@@ -230,6 +233,13 @@ def interface_dofs(model: FEModel, interface) -> np.ndarray:
         ref, spec = item if isinstance(item, tuple) and len(item) == 2 else (item, "all")
         nodes = node_indices(model.mesh, ref, "interface")
         found = (DOF_PER_NODE * nodes[:, None] + components(spec)).ravel()
+        tied = np.isin(found, model.tied)
+        if isinstance(ref, str):
+            found = found[~tied]
+        elif tied.any():
+            raise ValueError(f"interface DOF {dof_label(int(found[tied][0]))} belongs to the"
+                             " centre node of a quad8 skin on a solid face, which follows the"
+                             " cell's eight nodes; give those nodes or the skin's group")
         inactive = np.isin(found, model.inactive)
         if isinstance(spec, str) and spec == "all":
             found = found[~inactive]
