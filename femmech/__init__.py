@@ -74,3 +74,23 @@ __all__ = [
     "read_mesh",
     "refine_mesh",
 ]
+
+
+_OLD_MODULES = frozenset({
+    "assembly", "cache", "checks", "constraints", "dofs", "elements", "io", "linalg", "lobpcg",
+    "lumped", "materials", "mesh", "model", "parts", "recovery", "report", "scene_analyses",
+    "scene_build", "scene_machine", "scene_mechanisms", "scene_mesh", "scene_reader", "scene_run",
+    "scene_tasks", "solvers", "substructures", "superelement_file", "threads", "units",
+})
+"""Top-level modules of the previous layout, kept as old paths (docs/architecture.md,
+"Moved names"): ``femmech.io`` etc. still work as attributes of femmech."""
+
+
+def __getattr__(name: str):
+    """An old top-level module (``fm.linalg``) as an attribute: its names warn and lead to
+    their new places."""
+    if name in _OLD_MODULES:
+        import importlib
+
+        return importlib.import_module(f"femmech.{name}")
+    raise AttributeError(f"module 'femmech' has no attribute {name!r}")

@@ -352,8 +352,9 @@ def quasi_modal_basis(system: CoupledSystem, n_modes: int, n_angles: int = 8,
     ndarray (n, r), r <= n_modes · n_angles
         Orthonormal columns (Euclidean) in the system's global coordinates.
     """
-    if int(n_modes) != n_modes or not 1 <= n_modes <= system.n:
-        raise ValueError(f"n_modes must be an integer in 1..{system.n}, got {n_modes}")
+    if int(n_modes) != n_modes or not 1 <= n_modes < system.n:  # the branches of sweep
+        raise ValueError(f"n_modes must be an integer in 1..{system.n - 1} (the system has"
+                         f" {system.n} coordinates), got {n_modes}")
     if int(n_angles) != n_angles or n_angles < 1:
         raise ValueError(f"n_angles must be a positive integer, got {n_angles}")
     phi = np.arange(int(n_angles)) * (angle_period / n_angles)

@@ -268,6 +268,9 @@ class SpeedStudy:
         Columns of the Ritz basis used for the monodromy matrices.
     zeta : float
         Nominal frame damping ratio of ``line``.
+    notes : tuple of str
+        Defaults that adapted to the system (fewer basis modes or marked branches than
+        :data:`BASIS_MODES` and :data:`MARKED_BRANCHES` where the system has fewer).
     """
 
     line: StabilityChart
@@ -276,6 +279,7 @@ class SpeedStudy:
     mean_freq_hz: np.ndarray
     basis_size: int
     zeta: float = float("nan")
+    notes: tuple[str, ...] = ()
 
     def summary(self) -> str:
         """One line: the largest growth rate at nominal damping and the unstable points."""
@@ -287,12 +291,21 @@ class SpeedStudy:
         bad = sum(int(c.unconverged.sum()) for c in (self.line, self.chart) if c is not None)
         if bad:
             text += f"; {bad} points NOT CONVERGED (marked in the charts)"
-        return text
+        return text + "".join(f"; {note}" for note in self.notes)
+
+
+BASIS_MODES = 8
+"""Quasi-modes per angle of :func:`speed_study`'s Ritz basis when not given (all n - 1
+branches of a smaller system)."""
+
+MARKED_BRANCHES = 2
+"""Branches whose resonance speeds :func:`speed_study` marks when not given (all branches
+of a smaller system)."""
 
 
 def speed_study(system: CoupledSystem, speeds, zeta: float, band_hz: tuple[float, float],
-                damping_ratios=None, n_steps: int = 32, basis_modes: int = 8,
-                marked_branches: int = 2, orders=range(1, 13),
+                damping_ratios=None, n_steps: int = 32, basis_modes: int | None = None,
+                marked_branches: int | None = None, orders=range(1, 13),
                 angle_period: float = 2 * np.pi, rtol: float = RTOL,
                 max_steps: int = MAX_STEPS) -> SpeedStudy:
     """Stability of a machine over speed, with Rayleigh frame damping, in one call.
@@ -317,8 +330,11 @@ def speed_study(system: CoupledSystem, speeds, zeta: float, band_hz: tuple[float
     damping_ratios : array_like, optional
         Frame damping ratios of the two-parameter chart.
     n_steps, basis_modes, angle_period, rtol, max_steps
-        As in :func:`coupled_monodromy` and :func:`quasi_modal_basis`.
-    marked_branches : int
+        As in :func:`coupled_monodromy` and :func:`quasi_modal_basis` (``basis_modes``
+        None: :data:`BASIS_MODES`, at most the system's n - 1 branches).
+    marked_branches : int, optional
+        None: :data:`MARKED_BRANCHES`, at most the system's n - 1 branches. Adapted
+        defaults are said in :attr:`SpeedStudy.notes`.
     orders : sequence of int
         Harmonic orders j of the marks.
     """
@@ -327,6 +343,17 @@ def speed_study(system: CoupledSystem, speeds, zeta: float, band_hz: tuple[float
     def damped(ratio):
         return rayleigh_damping(system, *rayleigh_coefficients(ratio, *band_hz))
 
+    notes = []
+    if basis_modes is None:
+        basis_modes = min(BASIS_MODES, system.n - 1)
+        if basis_modes < BASIS_MODES:
+            notes.append(f"basis_modes not given: all {basis_modes} branches of the system"
+                         f" ({system.n} coordinates; the default is {BASIS_MODES})")
+    if marked_branches is None:
+        marked_branches = min(MARKED_BRANCHES, system.n - 1)
+        if marked_branches < MARKED_BRANCHES:
+            notes.append(f"marked_branches not given: the system's only branch (the default"
+                         f" is {MARKED_BRANCHES})")
     nominal = damped(zeta)
     basis = quasi_modal_basis(nominal, basis_modes, angle_period=angle_period)
     phi = np.linspace(0.0, angle_period, 36, endpoint=False)
@@ -340,4 +367,25 @@ def speed_study(system: CoupledSystem, speeds, zeta: float, band_hz: tuple[float
                                 n_steps=n_steps, angle_period=angle_period, rtol=rtol,
                                 max_steps=max_steps,
                                 parameter_name="frame damping ratio ζ (-)", basis=basis)
-    return SpeedStudy(line, chart, marks, mean_hz, basis.shape[1], float(zeta))
+    return SpeedStudy(line, chart, marks, mean_hz, basis.shape[1], float(zeta), tuple(notes))
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "ATOL": "femmech.analysis.magnus.ATOL",
+        "Floquet": "femmech.analysis.floquet.Floquet",
+        "GAUSS_OFFSETS": "femmech.analysis.magnus.GAUSS_OFFSETS",
+        "Monodromy": "femmech.analysis.magnus.Monodromy",
+        "coupled_floquet": "femmech.analysis.floquet.coupled_floquet",
+        "coupled_monodromy": "femmech.analysis.floquet.coupled_monodromy",
+        "expm_stack": "femmech.analysis.magnus.expm_stack",
+        "first_order_matrices": "femmech.analysis.magnus.first_order_matrices",
+        "floquet": "femmech.analysis.floquet.floquet",
+        "integrate_monodromy": "femmech.analysis.magnus.integrate_monodromy",
+        "monodromy": "femmech.analysis.floquet.monodromy",
+        "step_grid": "femmech.analysis.magnus.step_grid",
+    })

@@ -22,7 +22,7 @@ from __future__ import annotations
 import functools
 import warnings
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.linalg as sla
@@ -49,6 +49,10 @@ ZERO_RTOL = 1e-12
 
 UNSTABLE_RTOL = 1e-9
 """A branch is flagged unstable where its damping ratio is below ``-UNSTABLE_RTOL``."""
+
+DEFAULT_MODES = 6
+"""Branches followed when ``n_modes`` is not given: this many, or all a system has where it
+has fewer (the sweep's :attr:`Sweep.notes` say so)."""
 
 class _SolvePhase:
     """Default of the deprecated ``blas_threads``: the limits of :mod:`femmech.solve.threads`."""
@@ -85,6 +89,10 @@ class Sweep:
         cluster of close frequencies, the MAC with the cluster's span (subspace MAC).
     form : str
         ``"symmetric"``, ``"unsymmetric"`` or ``"damped"`` (the most general used).
+    notes : tuple of str
+        How the sweep was set up where a default adapted to the system, e.g. that
+        ``n_modes`` was left out and the system has fewer than :data:`DEFAULT_MODES`
+        branches (then all of them are followed).
     """
 
     phi: np.ndarray
@@ -94,13 +102,15 @@ class Sweep:
     vectors: np.ndarray | None
     mac_step: np.ndarray
     form: str
+    notes: tuple[str, ...] = ()
 
     def __repr__(self) -> str:
         phi = np.rad2deg(np.asarray(self.phi))
         f = np.asarray(self.freq_hz)
         band = f"{np.nanmin(f):.4g}..{np.nanmax(f):.4g} Hz" if f.size else "-"
+        notes = "".join(f"; {note}" for note in self.notes)
         return (f"Sweep({phi.size} angles {phi.min():.4g}..{phi.max():.4g} deg,"
-                f" {f.shape[-1]} branches over {band}; {self.form})")
+                f" {f.shape[-1]} branches over {band}; {self.form}{notes})")
 
     def _repr_html_(self) -> str:
         f = np.asarray(self.freq_hz)
@@ -112,7 +122,7 @@ class Sweep:
                          Flag("grows at some angles") if grows else ""))
         phi = np.rad2deg(np.asarray(self.phi))
         facts = [("drive angles", f"{phi.size}, {phi.min():.4g}° … {phi.max():.4g}°"),
-                 ("form", self.form)]
+                 ("form", self.form)] + [("note", note) for note in self.notes]
         return html_summary(f"Sweep: {f.shape[-1]} branches", facts,
                             ("branch", "min f / Hz", "max f / Hz", "min MAC step",
                              "frozen-angle growth"), rows)
@@ -243,7 +253,7 @@ def mac_matrix(X, Y, W=None) -> np.ndarray:
 
 
 def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0,
-          n_modes: int = 6, damped: bool = False, track: bool = True,
+          n_modes: int | None = None, damped: bool = False, track: bool = True,
           keep_vectors: bool = False, frequency_weight: float = 0.1,
           blas_threads=_SOLVE_PHASE) -> Sweep:
     """Quasi-modes of a coupled machine at many drive angles, with mode tracking.
@@ -268,8 +278,10 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
     Omega, Omega_dot : float
         Drive speed (rad/s) and acceleration (rad/s²); Ω = 0 gives the potential part
         of C only (symmetric for position-independent loads).
-    n_modes : int
-        Number of branches to follow.
+    n_modes : int, optional
+        Number of branches to follow, at most the system's branches (n - 1 of a coupled
+        system with n coordinates, n of a model alone). ``None``: :data:`DEFAULT_MODES`, or
+        all branches where the system has fewer (said in :attr:`Sweep.notes`).
     damped : bool
         Include B(φ) (first-order form); otherwise B is ignored.
     track : bool
@@ -295,19 +307,44 @@ def sweep(system: CoupledSystem, phi, Omega: float = 0.0, Omega_dot: float = 0.0
                          " superelements); use femmech.analysis.reference.full_modes for"
                          " an unreduced frame")
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
-    if not 0 < n_modes < system.n:
-        raise ValueError(f"n_modes must lie in 1..{system.n - 1}, got {n_modes}")
+    n_modes, notes = branch_count(n_modes, system.n - 1, "coupled system",
+                                  f"{system.n} coordinates")
     extra = min(n_modes + max(2, n_modes // 2), system.n - (0 if damped else 1))
     with _solve_phase(blas_threads):
         if not damped and (system.H is None or not len(system.H)):
             try:
-                return _lean_loop(_angle_stacks(system, phi, Omega, Omega_dot), system.n, phi,
-                                  n_modes, extra, track, keep_vectors, frequency_weight)
+                result = _lean_loop(_angle_stacks(system, phi, Omega, Omega_dot), system.n,
+                                    phi, n_modes, extra, track, keep_vectors, frequency_weight)
+                return replace(result, notes=notes)
             except _NotLeanError:
                 pass  # e.g. C(φ) unsymmetric at some angle: the general path below
         matrices = _angle_matrices(system, phi, Omega, Omega_dot, damped)
-        return _sweep_loop(matrices, system.n, system.H, phi, n_modes, extra, damped, track,
-                           keep_vectors, frequency_weight)
+        result = _sweep_loop(matrices, system.n, system.H, phi, n_modes, extra, damped, track,
+                             keep_vectors, frequency_weight)
+    return replace(result, notes=notes)
+
+
+def branch_count(n_modes, available: int, what: str, size: str) -> tuple[int, tuple[str, ...]]:
+    """``(n_modes, notes)``: the branches to follow and the note that says how a default
+    adapted.
+
+    ``n_modes`` None gives :data:`DEFAULT_MODES`, or all ``available`` branches where there
+    are fewer (with a note naming the count); an explicit count must lie in
+    1..``available``. ``what`` and ``size`` name the system in messages (e.g.
+    ``"mechanism model"``, ``"2 coordinates"``).
+    """
+    if n_modes is None:
+        if available < 1:
+            raise ValueError(f"the {what} ({size}) has no branch to follow")
+        if available >= DEFAULT_MODES:
+            return DEFAULT_MODES, ()
+        branches = f"{available} branch" + ("es" if available > 1 else "")
+        return available, (f"n_modes not given: the {what} ({size}) has {branches}, fewer"
+                           f" than the default {DEFAULT_MODES}; all are followed",)
+    if isinstance(n_modes, bool) or int(n_modes) != n_modes or not 0 < n_modes <= available:
+        raise ValueError(f"n_modes must be an integer in 1..{available} (the {what} has"
+                         f" {size}), got {n_modes}")
+    return int(n_modes), ()
 
 
 def _sweep_model(model, phi, Omega, Omega_dot, n_modes, damped, track, keep_vectors,
@@ -326,18 +363,19 @@ def _sweep_model(model, phi, Omega, Omega_dot, n_modes, damped, track, keep_vect
     if phi.ndim != 1:
         raise ValueError(f"phi must be 1-D (one drive), got shape {phi.shape}")
     matrices, n = _model_matrices(model, phi, Omega, Omega_dot, damped)
-    if int(n_modes) != n_modes or not 0 < n_modes <= n:
-        raise ValueError(f"n_modes must be an integer in 1..{n}, got {n_modes}")
-    extra = min(int(n_modes) + max(2, int(n_modes) // 2), n)
+    n_modes, notes = branch_count(n_modes, n, "mechanism model", f"{n} coordinates")
+    extra = min(n_modes + max(2, n_modes // 2), n)
     with _solve_phase(blas_threads):
         if not damped:
             try:
-                return _lean_loop(_model_stacks(matrices, n), n, phi, int(n_modes), extra,
-                                  track, keep_vectors, frequency_weight)
+                result = _lean_loop(_model_stacks(matrices, n), n, phi, n_modes, extra,
+                                    track, keep_vectors, frequency_weight)
+                return replace(result, notes=notes)
             except _NotLeanError:
                 pass  # e.g. C(φ) unsymmetric at some angle: the general path below
-        return _sweep_loop(matrices, n, None, phi, int(n_modes), extra, damped, track,
-                           keep_vectors, frequency_weight)
+        result = _sweep_loop(matrices, n, None, phi, n_modes, extra, damped, track,
+                             keep_vectors, frequency_weight)
+    return replace(result, notes=notes)
 
 
 def _model_stacks(matrices, n: int):
@@ -366,7 +404,7 @@ def _model_matrices(model, phi, Omega, Omega_dot, damped: bool):
     return (lambda a: (stacks["M"][a], None if B is None else B[a], stacks["C"][a])), n
 
 
-def parameter_sweep(system_at, values, phi: float = 0.0, n_modes: int = 6,
+def parameter_sweep(system_at, values, phi: float = 0.0, n_modes: int | None = None,
                     damped: bool = False, keep_vectors: bool = False,
                     frequency_weight: float = 0.1, blas_threads=_SOLVE_PHASE) -> Sweep:
     """Quasi-modes at a fixed drive angle over a parameter, with mode tracking.
@@ -392,6 +430,8 @@ def parameter_sweep(system_at, values, phi: float = 0.0, n_modes: int = 6,
     """
     values = np.atleast_1d(np.asarray(values, dtype=float))
     first, _ = system_at(values[0])
+    n_modes, notes = branch_count(n_modes, first.n - 1, "coupled system",
+                                  f"{first.n} coordinates")
     extra = min(n_modes + max(2, n_modes // 2), first.n - (0 if damped else 1))
 
     def matrices(a):
@@ -402,8 +442,9 @@ def parameter_sweep(system_at, values, phi: float = 0.0, n_modes: int = 6,
         return system.matrices(phi, Omega)[:3]
 
     with _solve_phase(blas_threads):
-        return _sweep_loop(matrices, first.n, first.H, values, n_modes, extra, damped, True,
-                           keep_vectors, frequency_weight)
+        result = _sweep_loop(matrices, first.n, first.H, values, n_modes, extra, damped, True,
+                             keep_vectors, frequency_weight)
+    return replace(result, notes=notes)
 
 
 @contextmanager

@@ -216,3 +216,14 @@ def solid_parts(mesh: Mesh, solids: dict[str, SolidProperty], n_dof: int):
         cells_by[kind] = cells
         group_by[kind] = np.array(names, dtype=object)[owner]
     return SolidSet(cells_by, group_by), stiff, mass
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+    }, removed={
+        "SHELL_TYPES": "use femmech.fe.elements.registry.kinds('shell')",
+    })

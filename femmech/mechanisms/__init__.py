@@ -135,3 +135,13 @@ __all__ = [
     "table_5_1_case",
     "velocity_symbol",
 ]
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "plot_quasi_frequencies": "femmech.output.sweeps.plot_quasi_frequencies",
+    })

@@ -127,3 +127,13 @@ def quasi_modes(model, phi, Omega=0.0, Omega_dot=0.0) -> QuasiModes:
     ok = (np.abs(lam.imag) <= 1e-9 * np.abs(lam)) & (lam.real > 0)
     freq = np.where(ok, np.sqrt(np.abs(lam.real)) / (2 * np.pi), np.nan)
     return QuasiModes(phi, lam, freq, modes, sym)
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "plot_quasi_frequencies": "femmech.output.sweeps.plot_quasi_frequencies",
+    })

@@ -46,3 +46,15 @@ __all__ = [
     "interface_error_estimates",
     "reduce_interface",
 ]
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "PIVOT_RTOL": "femmech.reduction.component_modes.PIVOT_RTOL",
+        "SYMMETRIC_BLOCK": "femmech.reduction.products.SYMMETRIC_BLOCK",
+        "THIN_PRODUCT_FLOPS": "femmech.reduction.products.THIN_PRODUCT_FLOPS",
+    })

@@ -143,3 +143,26 @@ def read(path) -> dict:
     if meta["format_version"] >= 2:
         _verify_checksums(meta, digests, file)
     return _fields(arrays, meta, dims, file)
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "CHUNK": "femmech.reduction.superelement_archive.CHUNK",
+        "DEFLATE_MAX_RATIO": "femmech.reduction.superelement_archive.DEFLATE_MAX_RATIO",
+        "EXPANSION_FLOOR": "femmech.reduction.superelement_archive.EXPANSION_FLOOR",
+        "INDICES": "femmech.reduction.superelement_format.INDICES",
+        "MAX_EXPANSION": "femmech.reduction.superelement_archive.MAX_EXPANSION",
+        "MAX_HEADER": "femmech.reduction.superelement_archive.MAX_HEADER",
+        "MAX_META_CHARS": "femmech.reduction.superelement_archive.MAX_META_CHARS",
+        "MAX_TIMINGS": "femmech.reduction.superelement_checks.MAX_TIMINGS",
+        "METHODS": "femmech.reduction.superelement_format.METHODS",
+        "PSD_RTOL": "femmech.reduction.superelement_checks.PSD_RTOL",
+        "READABLE_VERSIONS": "femmech.reduction.superelement_format.READABLE_VERSIONS",
+        "SYMMETRY_RTOL": "femmech.reduction.superelement_checks.SYMMETRY_RTOL",
+        "field_digest": "femmech.reduction.superelement_format.field_digest",
+        "meta_digest": "femmech.reduction.superelement_format.meta_digest",
+    })

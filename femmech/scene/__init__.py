@@ -17,3 +17,23 @@ from femmech.scene.load import Scene, load_scene
 from femmech.scene.run import RunResult, run_scene
 
 __all__ = ["Prepared", "RunResult", "Scene", "load_scene", "part_model", "prepare", "run_scene"]
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "GENERAL_OPTIONAL": "femmech.scene.load.GENERAL_OPTIONAL",
+        "InterfaceSpec": "femmech.scene.load.InterfaceSpec",
+        "ItemSpec": "femmech.scene.load.ItemSpec",
+        "MaterialSpec": "femmech.scene.load.MaterialSpec",
+        "PartSpec": "femmech.scene.load.PartSpec",
+        "REDUCTIONS": "femmech.scene.load.REDUCTIONS",
+        "ReductionSpec": "femmech.scene.load.ReductionSpec",
+        "SECTION_SHAPES": "femmech.scene.load.SECTION_SHAPES",
+        "SectionSpec": "femmech.scene.load.SectionSpec",
+        "ShellSpec": "femmech.scene.load.ShellSpec",
+        "SolidSpec": "femmech.scene.load.SolidSpec",
+    })

@@ -248,3 +248,20 @@ def _store(folder: Path, key: str, se: Superelement, label: str, problems: list)
         problems.append(f"cannot store ({_why(exc)})")
         return False
     return True
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "CacheInfo": "femmech.scene.cache_folder.CacheInfo",
+        "DEFAULT_MAX_BYTES": "femmech.scene.cache_folder.DEFAULT_MAX_BYTES",
+        "MAX_BYTES_ENV": "femmech.scene.cache_folder.MAX_BYTES_ENV",
+        "STALE_AGE": "femmech.scene.cache_folder.STALE_AGE",
+        "cache_info": "femmech.scene.cache_folder.cache_info",
+        "clear_cache": "femmech.scene.cache_folder.clear_cache",
+        "default_cache_dir": "femmech.scene.cache_folder.default_cache_dir",
+        "format_cache_info": "femmech.scene.cache_folder.format_cache_info",
+    })

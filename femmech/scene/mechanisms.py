@@ -175,3 +175,13 @@ def check_drive_event(scene, models: dict) -> None:
         if name not in allowed:
             raise fail(scene, where, "outputs", f"expected coordinates or spring forces of"
                        f" mechanism {spec.mechanism!r}, one of {list(allowed)}, got {name!r}")
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "FACTORIES": "femmech.scene.machine.BUILTIN_MODELS",
+    })

@@ -841,3 +841,15 @@ TASKS = {"modes": run_modes, "sweep": run_sweep, "stability": run_stability,
          "response": run_response, "check": run_check, "drive_event": run_drive_event,
          "chain_sweep": run_chain_sweep, "campbell": run_campbell,
          "synthesis": run_synthesis}
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "summary_section": "femmech.scene.summary.summary_section",
+    }, removed={
+        "RPM": "an internal factor; use femmech.output.charts.SPEED_UNITS['rpm']",
+    })

@@ -125,3 +125,14 @@ class Workshop:
 
 def _key(scene: Scene, spec, f_max_hz: float) -> str:
     return sha256_key(reduction_key_data(scene, spec, f_max_hz))
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+    }, removed={
+        "timings_table": "the report's appendix (femmech.scene.summary) has the timings",
+    })

@@ -189,3 +189,17 @@ def versions() -> dict[str, str]:
     if "pardiso" in available():
         out["pardiso"] = mkl_version() or "mkl"
     return out
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "PARALLEL_SOLVE_COLUMNS": "femmech.solve.pardiso.PARALLEL_SOLVE_COLUMNS",
+        "PARALLEL_SOLVE_MAX_BYTES": "femmech.solve.pardiso.PARALLEL_SOLVE_MAX_BYTES",
+        "PARDISO_LOOP_FILL": "femmech.solve.pardiso.PARDISO_LOOP_FILL",
+        "PARDISO_PERTURBATION": "femmech.solve.pardiso.PARDISO_PERTURBATION",
+        "PARDISO_SOLVE_MODE": "femmech.solve.pardiso.PARDISO_SOLVE_MODE",
+    })

@@ -419,3 +419,25 @@ def _sparse_band(K, M, band, sigma, factor=None):
         raise RuntimeError(f"band search found {omega2.size} of {count} eigenvalues"
                            f" (Sturm count) in [{lo:.6g}, {hi:.6g}] rad²/s²")
     return omega2, X, shift
+
+
+def __getattr__(name: str):
+    """Names this module had before the restructures, from their new places
+    (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "ALL_PAIRS_FRACTION": "femmech.solve.dense.ALL_PAIRS_FRACTION",
+        "BLOCK_SIZE": "femmech.solve.lanczos.BLOCK_SIZE",
+        "FAR_SHIFT": "femmech.solve.lanczos.FAR_SHIFT",
+        "GUARD_TOL": "femmech.solve.lanczos.GUARD_TOL",
+        "LANCZOS_TOL": "femmech.solve.lanczos.LANCZOS_TOL",
+        "MAX_BASIS_BYTES": "femmech.solve.lanczos.MAX_BASIS_BYTES",
+        "MAX_SOLVES_PER_MODE": "femmech.solve.lanczos.MAX_SOLVES_PER_MODE",
+        "PROBES": "femmech.solve.lanczos.PROBES",
+        "REORTHOGONALIZE_BELOW": "femmech.solve.lanczos.REORTHOGONALIZE_BELOW",
+        "RESIDUAL_TOL": "femmech.solve.residuals.RESIDUAL_TOL",
+        "SEMI_ORTHOGONAL": "femmech.solve.lanczos.SEMI_ORTHOGONAL",
+        "STREAM_COLUMNS": "femmech.solve.lanczos.STREAM_COLUMNS",
+        "residuals": "femmech.solve.residuals.residuals",
+    })

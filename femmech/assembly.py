@@ -1,0 +1,14 @@
+"""Old path of :mod:`femmech.fe.assembly` (previous layout).
+
+Every public name it had works here with a DeprecationWarning naming its new place
+(docs/architecture.md, "Moved names"); nothing inside femmech imports this module.
+"""
+
+
+def __getattr__(name: str):
+    """The previous layout's names, from their new places."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "assemble": "femmech.fe.assembly.assemble",
+    })
