@@ -43,6 +43,8 @@ def _cantilever(skin: bool, clamped: bool = True, hub: bool = False, supports=()
     last node at (L + H, 0, 0) for a link."""
     mesh = grid_solid(kind, np.linspace(0, L, N_X + 1),
                       *(np.linspace(-H / 2, H / 2, N_YZ + 1),) * 2)
+    # bound: grid coordinates are exact at x = 0 (linspace start), so the root face is
+    # selected by 0 < 1e-12 with no round-off at all
     root = np.flatnonzero(mesh.points[:, 0] < 1e-12)
     supports = [fm.Support(root, "translations")] * clamped + list(supports)
     shells = None
@@ -53,6 +55,8 @@ def _cantilever(skin: bool, clamped: bool = True, hub: bool = False, supports=()
         grid = corners[:, None, :] + ij  # (n_cells, 8, 2) indices into g
         X = np.stack([np.full(grid.shape[:2], L), g[grid[..., 0]], g[grid[..., 1]]], axis=-1)
         dist, cells = cKDTree(mesh.points).query(X.reshape(-1, 3))
+        # bound: both grids come from the same linspace values (|x| <= 0.1 m), equal up to
+        # a few eps * 0.1 m ~ 1e-16 m; 1e-12 m leaves the margin
         assert dist.max() < 1e-12  # the skin shares the solid's face nodes
         mesh = fm.Mesh(mesh.points, {**mesh.cells, "quad8": cells.reshape(-1, 8)},
                        {**mesh.cell_sets, "skin": {"quad8": np.arange(len(grid))}})

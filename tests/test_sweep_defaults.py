@@ -49,6 +49,7 @@ def test_two_dof_mechanism_alone_sweeps_with_defaults(two_dof):
     assert np.array_equal(result.freq_hz, explicit.freq_hz)  # the same computation
     # reference: quasi_modes solves the same 2x2 pencils by eigh (round-off of a 2x2
     # pencil, 1e-12 relative ~ 5e3 eps, as in tests/mechanisms/test_mechanism_gaps.py)
+    # bound: eigh of a 2x2 pencil, backward stable: rel. error <= ~10 eps * cond <= 1e-13
     assert_allclose(np.sort(result.freq_hz, axis=1), quasi_modes(two_dof, PHI).freq_hz,
                     rtol=1e-12)
 
@@ -78,6 +79,7 @@ def test_large_model_keeps_six_without_a_note():
     assert result.freq_hz.shape == (4, DEFAULT_MODES)
     assert result.notes == ()
     # f_i = √k_i / 2π exactly; LAPACK round-off on a diagonal 8x8 pencil, ~1e3 eps
+    # bound: diagonal pencil, eigh exact to a few eps in λ -> rel. error in f <= 1e-15
     assert_allclose(np.sort(result.freq_hz, axis=1), np.tile(np.arange(1.0, 7.0), (4, 1)),
                     rtol=1e-12)
 
@@ -89,6 +91,7 @@ def test_small_model_follows_all_branches():
     assert result.notes == ("n_modes not given: the mechanism model (3 coordinates) has 3"
                             " branches, fewer than the default 6; all are followed",)
     # analytic f = 3, 5, 7 Hz; round-off as above
+    # bound: diagonal pencil, eigh exact to a few eps in λ -> rel. error in f <= 1e-15
     assert_allclose(np.sort(result.freq_hz, axis=1), np.tile([3.0, 5.0, 7.0], (3, 1)),
                     rtol=1e-12)
 
