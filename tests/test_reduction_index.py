@@ -1,0 +1,106 @@
+"""Whether a reduced mode is the full model's mode of the same number (Sturm counts).
+
+The residual estimate of a superelement's modes measures the distance to *some* full
+eigenpair; a full mode that the reduction misses shifts the numbering of every reduced
+mode above it while the estimates stay small. References: dense ``scipy.linalg.eigh`` of
+the full ``K_free, M_free`` (independent of the reduction and of the counts).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+import femmech as fm
+from femmech.analysis.modes import superelement_modes
+from femmech.errors import ModelWarning
+from femmech.fe.generators import rectangular_plate
+from femmech.reduction.component_modes import craig_bampton
+from femmech.reduction.estimate import INDEX_RTOL, INDEX_SAFETY
+from femmech.solve.sturm import confirm_indices
+
+STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
+
+
+@pytest.fixture(scope="module")
+def plate():
+    """Cantilever steel plate 1 m x 0.8 m x 10 mm, 4 x 4 MITC4 (120 free DOFs), clamped
+    at x = 0; its dense eigenfrequencies (Hz) as the reference."""
+    mesh = rectangular_plate(1.0, 0.8, 4, 4)
+    model = fm.build_model(mesh, shells={"plate": fm.ShellProperty(0.01, STEEL)},
+                           supports=[fm.Support("edge_x0")])
+    lam = sla.eigh(model.K_free.toarray(), model.M_free.toarray(), eigvals_only=True)
+    return model, np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi)
+
+
+def _truth(reduced, f_full):
+    """Whether the dense full mode k lies in reduced mode k's interval (the definition)."""
+    w = np.maximum(INDEX_SAFETY * np.abs(reduced.error_estimate), INDEX_RTOL)
+    return f_full[:reduced.n_modes] >= reduced.freq_hz / (1.0 + w)
+
+
+def test_a_missed_full_mode_is_flagged(plate):
+    """1 fixed-interface mode + residual vectors at two free-edge nodes: reduced mode 10
+    is 27 % above full mode 10 (dense: 493.95 against 389.02 Hz) with an estimate of
+    5.5e-6 (it is full mode 12); the count flags it, and the flags are exactly the modes
+    whose full counterpart lies outside the interval."""
+    model, f_full = plate
+    se = craig_bampton(model, [4, 24], n_modes=1)
+    with pytest.warns(ModelWarning, match=r"reduced mode\(s\) .*10 \(493"):
+        reduced = superelement_modes(se, n_modes=12, model=model)
+    assert reduced.freq_hz[9] > 1.2 * f_full[9]
+    assert abs(reduced.error_estimate[9]) < 1e-4  # the estimate alone does not see it
+    assert not reduced.index_confirmed[9]
+    np.testing.assert_array_equal(reduced.index_confirmed, _truth(reduced, f_full))
+    assert reduced.n_unconfirmed == np.count_nonzero(~_truth(reduced, f_full)) >= 1
+    assert "UNCONFIRMED" in reduced._repr_html_()
+
+
+def test_an_accurate_reduction_is_confirmed(plate):
+    """12 fixed-interface modes: all 12 modes within 1e-5 of the dense reference and
+    confirmed, without a warning; index_check=False leaves the field unset."""
+    model, f_full = plate
+    se = craig_bampton(model, [4, 24], n_modes=12)
+    reduced = superelement_modes(se, n_modes=12, model=model)
+    assert np.all(reduced.freq_hz / f_full[:12] - 1 < 1e-5)
+    assert reduced.index_confirmed.all() and reduced.n_unconfirmed == 0
+    assert superelement_modes(se, n_modes=12, model=model,
+                              index_check=False).index_confirmed is None
+    assert superelement_modes(se, n_modes=12).index_confirmed is None
+
+
+def test_a_band_counts_from_its_first_mode(plate):
+    """A band above 0 numbers its modes after the reduced modes below it: the flags are
+    those of the same modes computed from the lowest."""
+    model, _ = plate
+    se = craig_bampton(model, [4, 24], n_modes=1)
+    with pytest.warns(ModelWarning):
+        lowest = superelement_modes(se, n_modes=12, model=model)
+    band = (0.5 * (lowest.freq_hz[2] + lowest.freq_hz[3]),
+            0.5 * (lowest.freq_hz[10] + lowest.freq_hz[11]))
+    with pytest.warns(ModelWarning, match=r"10 \(493"):
+        part = superelement_modes(se, band_hz=band, model=model)
+    assert part.n_modes == 8
+    np.testing.assert_array_equal(part.index_confirmed, lowest.index_confirmed[3:11])
+
+
+def test_confirm_indices_on_a_known_spectrum():
+    """K = diag(1 ... 6), M = I: eigenvalue k is k. An approximation of 3.5 claimed as
+    number 3 with the interval [3.4, 3.5] is not confirmed (3 eigenvalues below 3.4);
+    [2.9, 3.5] is; the intervals of a double eigenvalue share one count; lower <= 0
+    needs none."""
+    K, M = sp.diags(np.arange(1.0, 7.0)).tocsc(), sp.identity(6, format="csc")
+    ok, n = confirm_indices(K, M, [0.95, 1.95, 3.4], [1.0, 2.0, 3.5], [1, 2, 3])
+    np.testing.assert_array_equal(ok, [True, True, False])
+    assert n == 3
+    ok, n = confirm_indices(K, M, [0.95, 1.95, 2.9], [1.0, 2.0, 3.5], [1, 2, 3])
+    np.testing.assert_array_equal(ok, [True, True, True])
+    assert n == 3
+    double = sp.diags([1.0, 2.0, 2.0, 4.0]).tocsc()
+    ok, n = confirm_indices(double, sp.identity(4, format="csc"), [0.9, 1.9, 1.95],
+                            [1.0, 2.0, 2.0], [1, 2, 3])
+    assert ok.all() and n == 2  # modes 2 and 3 share the cut 1.95 (1 eigenvalue below)
+    ok, n = confirm_indices(K, M, [-np.inf, 0.0], [0.0, 0.0], [1, 2])
+    assert ok.all() and n == 0
