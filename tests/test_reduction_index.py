@@ -65,7 +65,8 @@ def test_an_accurate_reduction_is_confirmed(plate):
     se = craig_bampton(model, [4, 24], n_modes=12)
     reduced = superelement_modes(se, n_modes=12, model=model)
     assert np.all(reduced.freq_hz / f_full[:12] - 1 < 1e-5)
-    assert reduced.index_confirmed.all() and reduced.n_unconfirmed == 0
+    assert reduced.index_confirmed.all()
+    assert reduced.n_unconfirmed == 0
     assert superelement_modes(se, n_modes=12, model=model,
                               index_check=False).index_confirmed is None
     assert superelement_modes(se, n_modes=12).index_confirmed is None
@@ -101,6 +102,60 @@ def test_confirm_indices_on_a_known_spectrum():
     double = sp.diags([1.0, 2.0, 2.0, 4.0]).tocsc()
     ok, n = confirm_indices(double, sp.identity(4, format="csc"), [0.9, 1.9, 1.95],
                             [1.0, 2.0, 2.0], [1, 2, 3])
-    assert ok.all() and n == 2  # modes 2 and 3 share the cut 1.95 (1 eigenvalue below)
+    assert ok.all()
+    assert n == 2
     ok, n = confirm_indices(K, M, [-np.inf, 0.0], [0.0, 0.0], [1, 2])
-    assert ok.all() and n == 0
+    assert ok.all()
+    assert n == 0
+
+
+PLATE_SCENE = """
+[scene]
+name = "cantilever plate"
+
+[materials.steel]
+E = 210e9
+nu = 0.3
+rho = 7850.0
+
+[parts.plate.generator]
+kind = "rectangular_plate"
+a = 1.0
+b = 0.8
+divisions = [4, 4]
+
+[parts.plate.shells.plate]
+thickness = 0.01
+material = "steel"
+
+[[parts.plate.supports]]
+nodes = "edge_x0"
+
+[parts.plate.reduction]
+method = "craig_bampton"
+n_modes = 1
+interface = [{ nodes = [4, 24] }]
+
+[analyses.modes]
+n_modes = 12
+model = "reduced"
+images = 0
+vtu = true  # builds the full model: the table then has the estimate and the index
+"""
+
+
+def test_the_scene_marks_unconfirmed_modes(plate, tmp_path):
+    """The scene's reduced modes table marks the modes of the case above as unconfirmed
+    (in the HTML report and results), and the reductions table says so."""
+    import tomllib
+
+    from femmech.scene.load import Scene
+    from femmech.scene.run import run_scene
+
+    scene = Scene.from_dict(tomllib.loads(PLATE_SCENE), tmp_path, "plate.toml")
+    run_scene(scene, tmp_path / "out", cache_dir=None)
+    html = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
+    assert '<td class="flagged">unconfirmed</td>' in html
+    assert "reduced mode(s) marked unconfirmed" in html
+    assert "index unconfirmed for mode(s)" in html
+    assert "mode(s) 6, 10 (Sturm" in html  # the flags of the test above

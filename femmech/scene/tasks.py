@@ -131,15 +131,23 @@ def run_modes(ws, spec, out):
                                progress=lambda it: progress(it, "mode images", ws.bars))
         figures += [Figure(p.name, f"mode {i + 1}: {result.freq_hz[i]:.3f} Hz")
                     for i, p in enumerate(paths)]
-    est = result.error_estimate
+    est, confirmed = result.error_estimate, result.index_confirmed
     header = ("mode", "frequency (Hz)", "rigid") + (("estimated rel. error",) if est is not
-                                                    None else ())
+                                                    None else ()) + (
+        ("index vs full",) if confirmed is not None else ())
     rows = tuple((i + 1, Quantity(float(f), digits=6), "yes" if r else "no")
                  + ((Quantity(float(est[i]), digits=2),) if est is not None else ())
+                 + ((_index_cell(confirmed[i]),) if confirmed is not None else ())
                  for i, (f, r) in enumerate(zip(result.freq_hz, result.rigid, strict=True)))
     solver = f", factorisation {result.solver}" if result.solver else ""
     text = (f"Part {spec.part!r}, {spec.model} model ({result.method} solver{solver}):"
             f" {result.n_modes} modes.",)
+    if result.n_unconfirmed:
+        text += (f"{result.n_unconfirmed} reduced mode(s) marked unconfirmed: a Sturm count"
+                 " of the full model shows that the full mode of the same number lies below"
+                 " the error estimate (the reduction missed a mode below them); their"
+                 " estimates compare with another full mode. Keep more fixed-interface"
+                 " modes.",)
     extra = {}
     if spec.discretisation_error:  # opt-in: one h/2 refinement of the full model
         with ws.timed("discretisation estimate"):
@@ -161,6 +169,12 @@ def run_modes(ws, spec, out):
                       tuple(figures), tuple(files), gallery=True)
     return section, {"part": spec.part, "model": spec.model, "freq_hz": _list(result.freq_hz),
                      **extra}
+
+
+def _index_cell(confirmed):
+    """The index cell of a reduced mode: confirmed by the full model's Sturm count or
+    flagged."""
+    return "confirmed" if confirmed else Flagged("unconfirmed")
 
 
 def run_sweep(ws, spec, out):
