@@ -18,7 +18,7 @@ from femmech.analysis.modes import superelement_modes
 from femmech.errors import ModelWarning
 from femmech.fe.generators import rectangular_plate
 from femmech.reduction.component_modes import craig_bampton
-from femmech.reduction.estimate import INDEX_RTOL, INDEX_SAFETY
+from femmech.reduction.estimate import INDEX_RTOL, INDEX_SAFETY, confirmed_indices
 from femmech.solve.sturm import confirm_indices
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
@@ -50,6 +50,9 @@ def test_a_missed_full_mode_is_flagged(plate):
     se = craig_bampton(model, [4, 24], n_modes=1)
     with pytest.warns(ModelWarning, match=r"reduced mode\(s\) .*10 \(493"):
         reduced = superelement_modes(se, n_modes=12, model=model)
+    with pytest.warns(ModelWarning, match=r"reduced mode\(s\) .*10 \(493"):
+        each = superelement_modes(se, n_modes=12, model=model, index_check="each")
+    np.testing.assert_array_equal(each.index_confirmed, reduced.index_confirmed)
     assert reduced.freq_hz[9] > 1.2 * f_full[9]
     assert abs(reduced.error_estimate[9]) < 1e-4  # the estimate alone does not see it
     assert not reduced.index_confirmed[9]
@@ -69,6 +72,13 @@ def test_an_accurate_reduction_is_confirmed(plate):
     assert reduced.n_unconfirmed == 0
     assert superelement_modes(se, n_modes=12, model=model,
                               index_check=False).index_confirmed is None
+    # one count above mode 12 finds 12 full eigenvalues: it decides all 12 modes
+    ok, n_counts = confirmed_indices(model, reduced.omega2, reduced.error_estimate)
+    assert ok.all()
+    assert n_counts == 1
+    ok, n_counts = confirmed_indices(model, reduced.omega2, reduced.error_estimate, each=True)
+    assert ok.all()
+    assert n_counts == 12
     assert superelement_modes(se, n_modes=12).index_confirmed is None
 
 
@@ -159,3 +169,18 @@ def test_the_scene_marks_unconfirmed_modes(plate, tmp_path):
     assert "reduced mode(s) marked unconfirmed" in html
     assert "index unconfirmed for mode(s)" in html
     assert "mode(s) 6, 10 (Sturm" in html  # the flags of the test above
+
+
+def test_one_count_above_all_decides_when_nothing_is_missed():
+    """distinct=True: approximations of 1, 2, 3 (nothing missed) cost one count; of 1, 2
+    and 4 claimed as number 3 (3 missed) the top count finds 4 eigenvalues and the
+    per-entry counts flag number 3 only."""
+    K, M = sp.diags(np.arange(1.0, 7.0)).tocsc(), sp.identity(6, format="csc")
+    ok, n = confirm_indices(K, M, [0.95, 1.95, 2.95], [1.0, 2.0, 3.0], [1, 2, 3],
+                            distinct=True)
+    assert ok.all()
+    assert n == 1
+    ok, n = confirm_indices(K, M, [0.95, 1.95, 3.95], [1.0, 2.0, 4.0], [1, 2, 3],
+                            distinct=True)
+    np.testing.assert_array_equal(ok, [True, True, False])
+    assert n == 4

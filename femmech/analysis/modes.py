@@ -267,7 +267,8 @@ def model_eigenvalue_scale(model: FEModel) -> float:
 
 def superelement_modes(se: Superelement, n_modes: int | None = None,
                        band_hz: tuple[float, float] | None = None,
-                       model: FEModel | None = None, index_check: bool = True) -> ModeSet:
+                       model: FEModel | None = None, index_check: bool | str = True
+                       ) -> ModeSet:
     """Modes of a reduced model, ``K_r q = ω² M_r q``, recovered to all DOFs.
 
     Parameters
@@ -281,13 +282,16 @@ def superelement_modes(se: Superelement, n_modes: int | None = None,
         of its relative frequency error (:attr:`ModeSet.error_estimate`), computed from
         the residual in the full model without a full eigen solve, and for shell models
         its drilling share (:attr:`ModeSet.drilling`).
-    index_check : bool
+    index_check : bool or str
         With ``model``: confirm by Sturm counts of the full model that each reduced mode
         is the full mode of the same number within its estimate
         (:attr:`ModeSet.index_confirmed`, :func:`femmech.reduction.estimate.
-        confirmed_indices`). The estimate alone cannot see a full mode that the
-        reduction missed. Costs an indefinite factorisation of the full model per mode
-        (fewer where the estimates overlap); ``False`` skips it for models too large.
+        confirmed_indices`); the estimate alone cannot see a full mode that the
+        reduction missed. ``True`` (or ``"top"``): one count above the highest mode
+        (one indefinite factorisation of the full model), and a count per mode only if
+        it finds a missed mode; ``"each"``: a count per mode (fewer where the estimates
+        overlap), without assuming that the estimates bound the distance to distinct
+        full eigenvalues; ``False`` skips it for models too large to factorise.
 
     Returns
     -------
@@ -316,9 +320,13 @@ def superelement_modes(se: Superelement, n_modes: int | None = None,
     if model is not None:
         estimate = frequency_error_estimates(model, se, result.omega2, result.vectors)
     out = _with_drilling(_mode_set(result, se.recover(result.vectors), lam_max, estimate), model)
+    if index_check not in (True, False, None, "top", "each"):
+        raise ValueError(f"index_check must be True, False, 'top' or 'each', got"
+                         f" {index_check!r}")
     if model is not None and index_check and out.n_modes:
         first = 1 if band_hz is None else 1 + _count_below(Kr, Mr, float(result.omega2[0]))
-        confirmed, _ = confirmed_indices(model, result.omega2, estimate, first, out.rigid)
+        confirmed, _ = confirmed_indices(model, result.omega2, estimate, first, out.rigid,
+                                         each=index_check == "each")
         out = dataclasses.replace(out, index_confirmed=confirmed)
         if not confirmed.all():
             warnings.warn(_unconfirmed_message(out, first), ModelWarning, stacklevel=2)

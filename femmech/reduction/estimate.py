@@ -91,8 +91,8 @@ reduced solver's round-off."""
 
 
 def confirmed_indices(model: FEModel, omega2: np.ndarray, estimate: np.ndarray,
-                      first_index: int = 1, rigid: np.ndarray | None = None
-                      ) -> tuple[np.ndarray, int]:
+                      first_index: int = 1, rigid: np.ndarray | None = None,
+                      each: bool = False) -> tuple[np.ndarray, int]:
     """Whether each reduced mode is the full model's mode of the same number.
 
     :func:`frequency_error_estimates` measures how far a reduced eigenpair is from *some*
@@ -105,10 +105,16 @@ def confirmed_indices(model: FEModel, omega2: np.ndarray, estimate: np.ndarray,
     ``[λ̃_k / (1 + w_k)², λ̃_k]`` with ``w_k = max(INDEX_SAFETY |e_k|, INDEX_RTOL)``
     exactly when fewer than k full eigenvalues lie below the lower end (the upper end
     holds by Rayleigh-Ritz: the reduction is a Galerkin projection of the full model).
-    Costs one indefinite factorisation of the full ``K - c M`` per distinct cut
-    (:func:`femmech.solve.sturm.confirm_indices`: counts shared where the intervals
-    overlap; about one per mode for accurate, well-separated modes). Rigid-body modes
-    are confirmed without a count.
+    By default one count just above the highest mode decides every mode if it finds
+    exactly as many full eigenvalues as there are reduced ones up to there (nothing
+    missed), taking each interval to hold a full eigenvalue of its own, which is what the
+    estimate asserts (:func:`femmech.solve.sturm.confirm_indices` with ``distinct``);
+    where it finds more, or with ``each=True``, a count at the lower end of each mode's
+    interval decides without that assumption (counts shared where intervals overlap).
+    Each count is one indefinite factorisation of the full ``K - c M`` (measured on a
+    cantilever plate of 21 960 free DOFs, 10 modes: 1.2 s per count on a shared machine,
+    against 1.45 s for the modes and their estimates). Rigid-body modes are confirmed
+    without a count.
 
     Parameters
     ----------
@@ -123,6 +129,8 @@ def confirmed_indices(model: FEModel, omega2: np.ndarray, estimate: np.ndarray,
         modes; more for a band that starts above 0).
     rigid : ndarray (n_modes,) of bool, optional
         Rigid-body modes (no count).
+    each : bool
+        Count at every mode's interval (no assumption on the estimates).
 
     Returns
     -------
@@ -137,7 +145,7 @@ def confirmed_indices(model: FEModel, omega2: np.ndarray, estimate: np.ndarray,
     if rigid is not None:
         lower = np.where(rigid, -np.inf, lower)
     index = first_index + np.arange(lam.size)
-    return confirm_indices(model.K_free, model.M_free, lower, lam, index)
+    return confirm_indices(model.K_free, model.M_free, lower, lam, index, distinct=not each)
 
 
 @dataclass(frozen=True)

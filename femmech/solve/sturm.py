@@ -61,8 +61,8 @@ def _cut_above(lam: float, scale: float) -> float:
     return lam + 1e-6 * max(abs(lam), 1e-6 * scale)
 
 
-def confirm_indices(K, M, lower: np.ndarray, upper: np.ndarray, index: np.ndarray
-                    ) -> tuple[np.ndarray, int]:
+def confirm_indices(K, M, lower: np.ndarray, upper: np.ndarray, index: np.ndarray,
+                    distinct: bool = False) -> tuple[np.ndarray, int]:
     """Whether the ``index``-th eigenvalue of ``K x = λ M x`` lies above ``lower``, by counts.
 
     For approximate eigenvalues with claimed positions ``index`` (1-based, counted from
@@ -85,6 +85,15 @@ def confirm_indices(K, M, lower: np.ndarray, upper: np.ndarray, index: np.ndarra
     semi-definite). An entry whose count cannot be made (off-diagonal pivots) stays
     unconfirmed.
 
+    ``distinct=True`` takes each interval to hold an eigenvalue of its own (what an
+    error bound of each approximation asserts) and starts with one count just above the
+    highest interval: if it finds exactly ``max(index)`` eigenvalues, entry k is confirmed
+    wherever its ``lower`` is not above that of a higher entry (if ``λ_k`` were below it,
+    the ``max(index) - k + 1`` entries from k up would need distinct eigenvalues among
+    the ``max(index) - k`` above ``λ_k``). Well-separated accurate approximations then
+    cost one count in all; where the count finds more (a missed eigenvalue) the
+    per-entry counts above decide.
+
     Parameters
     ----------
     K, M : sparse (n, n)
@@ -92,6 +101,9 @@ def confirm_indices(K, M, lower: np.ndarray, upper: np.ndarray, index: np.ndarra
         Interval ends, rad²/s² (``lower <= upper``).
     index : ndarray (m,) of int
         Claimed 1-based position of each approximate eigenvalue in the spectrum.
+
+    distinct : bool
+        Start with the one count above all intervals (see above).
 
     Returns
     -------
@@ -105,7 +117,7 @@ def confirm_indices(K, M, lower: np.ndarray, upper: np.ndarray, index: np.ndarra
     status = np.where(lower <= 0.0, 1, 0)  # 1 confirmed, -1 not confirmed, 0 undecided
     like, failed, n_counts = None, set(), 0
 
-    def count(cut: float) -> None:
+    def count(cut: float) -> int | None:
         nonlocal like, n_counts
         n_counts += 1
         A = K - cut * M
@@ -117,11 +129,19 @@ def confirm_indices(K, M, lower: np.ndarray, upper: np.ndarray, index: np.ndarra
         m = None if lu is None else lu.n_negative
         if m is None:
             failed.add(cut)
-            return
+            return None
         like = like if like is not None else lu
         open_ = status == 0
         status[open_ & (lower <= cut) & (m < index)] = 1
         status[open_ & (lower >= cut) & (m >= index)] = -1
+        return m
+
+    if distinct and np.any(status == 0):
+        top = float(upper.max())
+        if count(_cut_above(top, abs(top))) == int(index.max()):
+            order = np.argsort(index, kind="stable")
+            above = np.minimum.accumulate(lower[order][::-1])[::-1]  # min over j >= k
+            status[order[(status[order] == 0) & (lower[order] <= above)]] = 1
 
     for group in _common_point_groups(lower, upper, np.flatnonzero(status == 0)):
         group = group[status[group] == 0]
