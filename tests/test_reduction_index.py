@@ -184,3 +184,23 @@ def test_one_count_above_all_decides_when_nothing_is_missed():
                             distinct=True)
     np.testing.assert_array_equal(ok, [True, True, False])
     assert n == 4
+
+
+def test_reduced_versus_full_rows_name_the_full_mode_they_match():
+    """The check's table: reduced modes 2 and 3 that resemble full modes 3 and 4 (largest
+    MAC) and lie nearer to them in frequency are matched to them (the reduction missed
+    full mode 2); a mixed pair of equal frequencies (MAC off the diagonal, same
+    frequency) keeps its numbers."""
+    from femmech.analysis.reference import Comparison
+    from femmech.scene.tasks import matched_full_modes
+
+    missed = np.zeros((1, 4, 4))
+    missed[0, [0, 1, 2, 3], [0, 2, 3, 3]] = 1.0
+    comp = Comparison(np.zeros(1), np.array([[10.0, 20.0, 30.0, 40.0]]),
+                      np.array([[10.0, 30.001, 40.001, 55.0]]), missed, np.zeros(1), 0.0)
+    np.testing.assert_array_equal(matched_full_modes(comp), [[0, 2, 3, 3]])
+    pair = np.zeros((1, 4, 4))
+    pair[0, [0, 1, 2, 3], [0, 2, 1, 3]] = 1.0
+    comp = Comparison(np.zeros(1), np.array([[10.0, 20.0, 20.0, 40.0]]),
+                      np.array([[10.0, 20.0, 20.0, 40.0]]), pair, np.zeros(1), 0.0)
+    np.testing.assert_array_equal(matched_full_modes(comp), [[0, 1, 2, 3]])
