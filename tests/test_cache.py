@@ -42,7 +42,8 @@ from femmech.scene.run import run_scene
 ROOT = Path(__file__).resolve().parent.parent
 
 # Two reduced parts joined at the four top joints of the base (assembled superelements),
-# with a cam mechanism on the rail's mid node and the base's top: a sweep needs both.
+# with a cam mechanism on the rail's mid node (on the rail's interface: mechanisms mount
+# at interface nodes only) and the base's top: a sweep needs both.
 TWO_PARTS = """
 [scene]
 name = "two parts"
@@ -90,7 +91,7 @@ material = "aluminium"
 [parts.rail.reduction]
 method = "craig_bampton"
 n_modes = 3
-interface = [{ nodes = "a" }, { nodes = "b" }]
+interface = [{ nodes = "a" }, { nodes = "b" }, { nodes = "mid" }]  # mid: the cam's node
 
 [mechanisms.cam]
 model = "cam_follower"

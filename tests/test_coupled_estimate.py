@@ -198,7 +198,7 @@ def test_refuses_mechanisms_on_interior_dofs():
     inner = Mount(model_, (Attachment("q_s", int(cams[0]) + 1, "rx"),
                            Attachment("y_g", int(guides[0]), "uz")), name="offset cam")
     for se in (craig_bampton(model, interface, f_max_hz=400.0), guyan(model, interface)):
-        system = couple(se, [inner])
+        system = couple(se, [inner], allow_interior=True)  # couple refuses it by default
         s = sweep(system, PHI[:2], n_modes=3, keep_vectors=True, track=False)
         with pytest.raises(ValueError, match="offset cam.*interface DOFs only"):
             coupled_error_estimates(coupled_error_forms(model, se), system, s.eigenvalues,

@@ -6,17 +6,19 @@ Stage 5 (analysis): uses reduction, fe and solve; nothing here writes files.
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 
 from femmech.analysis.shell_checks import drilling_findings, drilling_fractions
+from femmech.errors import ModelWarning
 from femmech.fe import checks
 from femmech.fe.dofs import DOF_PER_NODE
 from femmech.fe.model import FEModel
 from femmech.html import html_summary
-from femmech.reduction.estimate import frequency_error_estimates
+from femmech.reduction.estimate import confirmed_indices, frequency_error_estimates
 from femmech.reduction.superelement import Superelement
 from femmech.solve import direct
 from femmech.solve.eigen import RIGID_TOL, solve_symmetric
@@ -60,6 +62,13 @@ class ModeSet:
         (:func:`femmech.analysis.shell_checks.drilling_fractions`); near 1 for the
         spurious drilling modes of thick shells, near 0 for structural modes. None for
         models without shells.
+    index_confirmed : ndarray (n_modes,) of bool or None
+        For modes of a reduced model checked against the unreduced one
+        (:func:`superelement_modes` with ``model``): True where a Sturm count of the full
+        model confirms that the full mode of the same number lies within the error
+        estimate (:func:`femmech.reduction.estimate.confirmed_indices`); False where the
+        reduction missed a full mode below it, so that the estimate compares it with
+        another full mode. None if not checked.
     """
 
     freq_hz: np.ndarray
@@ -73,6 +82,7 @@ class ModeSet:
     error_estimate: np.ndarray | None = None
     solver: str | None = None
     drilling: np.ndarray | None = None
+    index_confirmed: np.ndarray | None = None
 
     def __repr__(self) -> str:
         f = np.asarray(self.freq_hz)
@@ -82,16 +92,25 @@ class ModeSet:
 
     def _repr_html_(self) -> str:
         f, estimate = np.asarray(self.freq_hz), self.error_estimate
+        confirmed = self.index_confirmed
         header = ("mode", "f / Hz", "rigid", "residual") + (
-            ("error estimate",) if estimate is not None else ())
+            ("error estimate",) if estimate is not None else ()) + (
+            ("index",) if confirmed is not None else ())
         rows = [(k + 1, float(f[k]), "yes" if self.rigid[k] else "", float(self.residual[k]))
                 + ((float(estimate[k]),) if estimate is not None else ())
+                + ((_index_text(confirmed[k]),) if confirmed is not None else ())
                 for k in range(f.size)]
         facts = [("method", self.method + (f" ({self.solver})" if self.solver else "")),
                  ("shift σ / (rad/s)²", float(self.sigma)),
                  ("Sturm count", "not checked" if self.sturm_count is None
                   else self.sturm_count)]
         return html_summary(f"ModeSet: {f.size} modes", facts, header, rows)
+
+    @property
+    def n_unconfirmed(self) -> int:
+        """Number of modes whose index the full model did not confirm (0 if not checked)."""
+        c = self.index_confirmed
+        return 0 if c is None else int(np.count_nonzero(~np.asarray(c)))
 
     @property
     def n_modes(self) -> int:
@@ -101,6 +120,10 @@ class ModeSet:
     def nodal(self, mode: int) -> np.ndarray:
         """Nodal values of one mode, shape (n_nodes, 6): ux, uy, uz, rx, ry, rz."""
         return self.shapes[:, mode].reshape(-1, 6)
+
+
+def _index_text(confirmed) -> str:
+    return "confirmed" if confirmed else "UNCONFIRMED"
 
 
 def modes(model: FEModel, n_modes: int | None = None, band_hz: tuple[float, float] | None = None,
@@ -244,7 +267,8 @@ def model_eigenvalue_scale(model: FEModel) -> float:
 
 def superelement_modes(se: Superelement, n_modes: int | None = None,
                        band_hz: tuple[float, float] | None = None,
-                       model: FEModel | None = None) -> ModeSet:
+                       model: FEModel | None = None, index_check: bool | str = True
+                       ) -> ModeSet:
     """Modes of a reduced model, ``K_r q = ω² M_r q``, recovered to all DOFs.
 
     Parameters
@@ -258,11 +282,26 @@ def superelement_modes(se: Superelement, n_modes: int | None = None,
         of its relative frequency error (:attr:`ModeSet.error_estimate`), computed from
         the residual in the full model without a full eigen solve, and for shell models
         its drilling share (:attr:`ModeSet.drilling`).
+    index_check : bool or str
+        With ``model``: confirm by Sturm counts of the full model that each reduced mode
+        is the full mode of the same number within its estimate
+        (:attr:`ModeSet.index_confirmed`, :func:`femmech.reduction.estimate.
+        confirmed_indices`); the estimate alone cannot see a full mode that the
+        reduction missed. ``True`` (or ``"top"``): one count above the highest mode
+        (one indefinite factorisation of the full model), and a count per mode only if
+        it finds a missed mode; ``"each"``: a count per mode (fewer where the estimates
+        overlap), without assuming that the estimates bound the distance to distinct
+        full eigenvalues; ``False`` skips it for models too large to factorise.
 
     Returns
     -------
     ModeSet
         ``shapes`` are the recovered full-model shapes (n_dof, n_modes).
+
+    Warns
+    -----
+    ModelWarning
+        Naming the modes whose index the full model did not confirm.
     """
     Kr, Mr = se.K, se.M
     # a reduced pencil mixes interface and modal coordinates whose diagonal ratios differ
@@ -281,9 +320,40 @@ def superelement_modes(se: Superelement, n_modes: int | None = None,
     if model is not None:
         estimate = frequency_error_estimates(model, se, result.omega2, result.vectors)
     out = _with_drilling(_mode_set(result, se.recover(result.vectors), lam_max, estimate), model)
+    if index_check not in (True, False, None, "top", "each"):
+        raise ValueError(f"index_check must be True, False, 'top' or 'each', got"
+                         f" {index_check!r}")
+    if model is not None and index_check and out.n_modes:
+        first = 1 if band_hz is None else 1 + _count_below(Kr, Mr, float(result.omega2[0]))
+        confirmed, _ = confirmed_indices(model, result.omega2, estimate, first, out.rigid,
+                                         each=index_check == "each")
+        out = dataclasses.replace(out, index_confirmed=confirmed)
+        if not confirmed.all():
+            warnings.warn(_unconfirmed_message(out, first), ModelWarning, stacklevel=2)
     lowest = band_hz is None or band_hz[0] == 0
     checks.warn(checks.frequency_findings(out.freq_hz, out.rigid, False, lowest))
     return out
+
+
+def _unconfirmed_message(out: ModeSet, first: int) -> str:
+    bad = np.flatnonzero(~out.index_confirmed)
+    names = ", ".join(f"{first + k} ({out.freq_hz[k]:.5g} Hz)" for k in bad[:5])
+    more = f" and {bad.size - 5} more" if bad.size > 5 else ""
+    return (f"reduced mode(s) {names}{more}: index not confirmed, the full model's mode of"
+            " the same number lies below the error estimate (Sturm count): the reduction"
+            " missed a full mode below, so the estimate compares with another full mode;"
+            " keep more fixed-interface modes (n_modes, cutoff_hz or f_max_hz of"
+            " craig_bampton)")
+
+
+def _count_below(K, M, lam: float) -> int:
+    """Number of eigenvalues of the dense pencil (K, M) below ``lam`` less a relative
+    1e-9 (the modes of a band below its first computed one)."""
+    sigma = default_shift(K, M)
+    mu = scipy.linalg.eigh(M, K - sigma * M, eigvals_only=True)
+    cut = lam - 1e-9 * max(abs(lam), 1e-300)
+    finite = mu > 1e-12 * mu.max()
+    return int(np.count_nonzero(sigma + 1.0 / mu[finite] < cut))
 
 
 def _largest_eigenvalue(K, M) -> float:

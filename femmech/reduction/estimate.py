@@ -5,6 +5,9 @@ model from the residuals of the reduced eigenpairs on the interior DOFs, reusing
 ``K_ii`` factorisation of the reduction (no solve of the full model):
 
 * :func:`frequency_error_estimates`: modes of the superelement alone;
+* :func:`confirmed_indices`: whether each reduced mode is the full model's mode of the
+  same number within its estimate (Sturm counts of the full model; a residual estimate
+  alone cannot see a full mode that the reduction missed);
 * :func:`coupled_error_forms` and :func:`coupled_error_estimates`: quasi-modes of a
   coupled machine (mechanisms mounted on the superelement's interface) over a whole
   sweep, as a quadratic form in the reduced coordinates (three n_r × n_r matrices built
@@ -29,6 +32,7 @@ from femmech.fe.model import FEModel
 from femmech.reduction.products import plus_sparse, product_phase, symmetric_product
 from femmech.reduction.superelement import Superelement
 from femmech.solve.pencil import factorize
+from femmech.solve.sturm import confirm_indices
 
 REAL_RTOL = 1e-9
 """Eigenvalues with ``|Im λ| <= REAL_RTOL |λ|`` and vectors with imaginary parts below
@@ -72,6 +76,76 @@ def frequency_error_estimates(model: FEModel, se: Superelement, omega2: np.ndarr
     scale = np.abs(se.K).max() / max(np.abs(se.M).max(), 1e-300)
     rigid = np.abs(omega2) <= 1e-12 * scale
     return np.where(rigid, 0.0, 0.5 * eta / np.where(rigid, 1.0, omega2))
+
+
+INDEX_SAFETY = 2.0
+"""The interval of :func:`confirmed_indices` is this many times the error estimate wide:
+the first-order estimate underestimates the error by the factor ``1 - λ/ω²_j`` of the
+lowest fixed-interface mode left out (up to 1/4 below ``f_max`` with the default
+cutoff of twice ``f_max``, i.e. an error up to 1.33 times the estimate)."""
+
+INDEX_RTOL = 1e-6
+"""Smallest relative width (in frequency) of the interval of :func:`confirmed_indices`:
+the relative margin of the Sturm cuts of :mod:`femmech.solve.sturm`, above the dense
+reduced solver's round-off."""
+
+
+def confirmed_indices(model: FEModel, omega2: np.ndarray, estimate: np.ndarray,
+                      first_index: int = 1, rigid: np.ndarray | None = None,
+                      each: bool = False) -> tuple[np.ndarray, int]:
+    """Whether each reduced mode is the full model's mode of the same number.
+
+    :func:`frequency_error_estimates` measures how far a reduced eigenpair is from *some*
+    eigenpair of the full model. If the reduction misses a full mode (too few
+    fixed-interface modes for a mode with little interface motion), every reduced mode
+    above it is compared with the wrong full mode: measured on a cantilever plate reduced
+    with 1 fixed-interface mode and residual vectors, reduced mode 10 lies 27 % above the
+    full mode 10 with an estimate of 5.5e-6 (it is within 1e-5 of full mode 12). A
+    Sturm count settles it: the ``k``-th full eigenvalue lies in
+    ``[λ̃_k / (1 + w_k)², λ̃_k]`` with ``w_k = max(INDEX_SAFETY |e_k|, INDEX_RTOL)``
+    exactly when fewer than k full eigenvalues lie below the lower end (the upper end
+    holds by Rayleigh-Ritz: the reduction is a Galerkin projection of the full model).
+    By default one count just above the highest mode decides every mode if it finds
+    exactly as many full eigenvalues as there are reduced ones up to there (nothing
+    missed), taking each interval to hold a full eigenvalue of its own, which is what the
+    estimate asserts (:func:`femmech.solve.sturm.confirm_indices` with ``distinct``);
+    where it finds more, or with ``each=True``, a count at the lower end of each mode's
+    interval decides without that assumption (counts shared where intervals overlap).
+    Each count is one indefinite factorisation of the full ``K - c M`` (measured on a
+    cantilever plate of 21 960 free DOFs, 10 modes: 1.2 s per count on a shared machine,
+    against 1.45 s for the modes and their estimates). Rigid-body modes are confirmed
+    without a count.
+
+    Parameters
+    ----------
+    model : FEModel
+        The model that was reduced.
+    omega2 : ndarray (n_modes,)
+        Reduced eigenvalues, ascending, rad²/s².
+    estimate : ndarray (n_modes,)
+        Their relative frequency error estimates (:func:`frequency_error_estimates`).
+    first_index : int
+        Position (1-based) of ``omega2[0]`` in the reduced spectrum (1 for the lowest
+        modes; more for a band that starts above 0).
+    rigid : ndarray (n_modes,) of bool, optional
+        Rigid-body modes (no count).
+    each : bool
+        Count at every mode's interval (no assumption on the estimates).
+
+    Returns
+    -------
+    confirmed : ndarray (n_modes,) of bool
+        True where the full model's mode of the same number lies within the interval.
+    n_counts : int
+        Factorisations of the full model made.
+    """
+    lam = np.asarray(omega2, dtype=float)
+    width = np.maximum(INDEX_SAFETY * np.abs(np.asarray(estimate, dtype=float)), INDEX_RTOL)
+    lower = lam / (1.0 + width) ** 2
+    if rigid is not None:
+        lower = np.where(rigid, -np.inf, lower)
+    index = first_index + np.arange(lam.size)
+    return confirm_indices(model.K_free, model.M_free, lower, lam, index, distinct=not each)
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,9 @@
 """Stage 3: the container of a superelement file: zip members and ``.npy`` headers.
 
-Checks the member list and each member's zip entry (compression, encryption, sizes the
+Opens only regular files (:func:`open_regular`: a FIFO would block the reader, a
+device such as ``/dev/zero`` would feed it without end), then checks that the file is
+not much larger than its members (:func:`_members`), the member list and each member's
+zip entry (compression, encryption, sizes the
 compressed bytes can produce) and each ``.npy`` header (version, dtype, number of
 dimensions, a declared shape that fills the member exactly) before any data is read, then
 reads a member's data in bounded chunks while hashing it. What a damaged archive makes
@@ -15,6 +18,8 @@ from __future__ import annotations
 import contextlib
 import io
 import math
+import os
+import stat
 import struct
 import tokenize
 import zipfile
@@ -30,6 +35,7 @@ from femmech.reduction.superelement_format import (
     FLOATS,
     _digest_start,
     _fail,
+    _name,
     _show,
     _unreadable,
 )
@@ -44,6 +50,68 @@ read. Real files expand 1.1-1.8-fold (measured on frames and shells of 1 128-9 4
 Guyan and Craig-Bampton): Psi and Phi, dense floats, dominate and hardly compress."""
 
 EXPANSION_FLOOR = 1 << 24
+
+ZIP_OVERHEAD = 1024
+"""Most bytes of zip headers per member (local and central header with the member's name
+twice, zip64 extras, data descriptor) that :func:`_members` allows beyond the members'
+compressed data."""
+
+ZIP_TAIL = 65_557 + 76 + (1 << 20)
+"""Bytes allowed beyond the members and their headers: the end-of-central-directory record
+with the longest comment, the zip64 end records, and 1 MiB of slack. A larger file holds
+data that is no member (a file padded or appended to) and is refused before it is read."""
+
+_KINDS = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"), (stat.S_ISDIR, "a directory"),
+          (stat.S_ISSOCK, "a socket"))
+
+
+def open_regular(path, what: str = "superelement file"):
+    """Open ``path`` for binary reading if it is a regular file (after symlinks).
+
+    The kind is checked before the file is opened (``os.stat``) and again on the open
+    descriptor (``os.fstat``, against a swap in between); the open does not block
+    (``O_NONBLOCK``: a FIFO without a writer would wait forever, a read of ``/dev/zero``
+    never ends).
+
+    Raises
+    ------
+    FileNotFoundError
+        If there is no file ``path``.
+    FileFormatError
+        One line naming the file and what it is instead (FIFO, device, directory,
+        socket; a symbolic link's target), or why it cannot be opened.
+    """
+    file = _name(path)
+    try:
+        _require_regular(os.stat(path), path, file, what)
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0)
+                     | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_BINARY", 0))
+    except (FileNotFoundError, FileFormatError):
+        raise
+    except OSError as exc:
+        raise FileFormatError(f"{file}: cannot open the {what}: {type(exc).__name__}:"
+                              f" {exc.strerror or exc}") from exc
+    try:
+        _require_regular(os.fstat(fd), path, file, what)
+        if hasattr(os, "set_blocking"):
+            os.set_blocking(fd, True)
+        return os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def _require_regular(info: os.stat_result, path, file: str, what: str) -> None:
+    if stat.S_ISREG(info.st_mode):
+        return
+    kind = next((text for test, text in _KINDS if test(info.st_mode)), "not a regular file")
+    link = ""
+    if os.path.islink(path):
+        link = f" (a symbolic link to {_name(os.path.realpath(path))})"
+    raise FileFormatError(f"{file}: is {kind}{link}, not a regular file; a {what} must be"
+                          " a regular file")
+
 
 MAX_HEADER = 10_000
 """Longest ``.npy`` header read, bytes (numpy's own limit for untrusted files)."""
@@ -116,6 +184,11 @@ def _members(archive: zipfile.ZipFile, size: int, file: str) -> dict:
             raise _unreadable(file, f"{where} declares {info.file_size} bytes from"
                                     f" {info.compress_size} compressed bytes, more than"
                                     " the compression can produce")
+    held = sum(info.compress_size + ZIP_OVERHEAD + 2 * len(info.filename) for info in infos)
+    if size > held + ZIP_TAIL:
+        raise _unreadable(file, f"the file has {size} bytes, its members only {held} with"
+                                " their headers: it holds data that is no member (padded"
+                                " or appended to?)")
     declared = sum(info.file_size for info in infos)
     if declared > MAX_EXPANSION * size + EXPANSION_FLOOR:
         raise _unreadable(file, f"the members declare {declared} bytes, more than"

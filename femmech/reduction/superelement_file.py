@@ -57,7 +57,13 @@ from pathlib import Path
 
 import numpy as np
 
-from femmech.reduction.superelement_archive import _data, _header, _members, _reading
+from femmech.reduction.superelement_archive import (
+    _data,
+    _header,
+    _members,
+    _reading,
+    open_regular,
+)
 from femmech.reduction.superelement_checks import _dims, _fields, _meta, _verify_checksums
 from femmech.reduction.superelement_format import (
     ARRAYS,
@@ -65,7 +71,6 @@ from femmech.reduction.superelement_format import (
     FLOATS,
     FORMAT_VERSION,
     _name,
-    _unreadable,
     checksums,
 )
 
@@ -117,16 +122,12 @@ def read(path) -> dict:
         If there is no file ``path``.
     FileFormatError
         One line naming the file and the field, if the file is not a valid superelement
-        file (truncated, damaged, foreign, crafted, or of another format version).
+        file (truncated, damaged, foreign, crafted, or of another format version), or
+        naming the file if it is no regular file (a FIFO, a device such as a link to
+        ``/dev/zero``, a directory: refused before it is opened for reading).
     """
     file = _name(path)
-    try:
-        stream = open(path, "rb")
-    except FileNotFoundError:
-        raise
-    except OSError as exc:
-        raise _unreadable(file, f"{type(exc).__name__}: {exc}") from exc
-    with stream:
+    with open_regular(path) as stream:
         size = os.fstat(stream.fileno()).st_size
         with _reading(file, "zip archive"):
             archive = zipfile.ZipFile(stream)

@@ -41,9 +41,10 @@ from pathlib import Path
 
 from filelock import FileLock, Timeout
 
-from femmech.errors import CacheWarning
+from femmech.errors import CacheWarning, FileFormatError
 from femmech.output.export import atomic_path
 from femmech.reduction.superelement import FORMAT_VERSION, Superelement
+from femmech.reduction.superelement_archive import open_regular
 from femmech.scene.cache_folder import (
     _evict,
     _remove,
@@ -88,9 +89,13 @@ def _why(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {exc}".replace("\n", " ")
 
 
+MAX_MANIFEST = 1 << 20
+"""Largest manifest read, bytes (a manifest holds a few hundred)."""
+
+
 def _sha256_file(path: Path) -> str:
     digest = hashlib.sha256()
-    with open(path, "rb") as stream:
+    with open_regular(path, "cache entry") as stream:  # a FIFO or a device: FileFormatError
         for block in iter(lambda: stream.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()
@@ -104,10 +109,10 @@ def read_entry(folder, key: str) -> tuple[Superelement | None, str | None]:
         if not data_path.exists() and not manifest_path.exists():
             return None, None
         try:
-            manifest = json.loads(manifest_path.read_text(encoding="utf-8"))
+            manifest = json.loads(_read_manifest(manifest_path))
         except FileNotFoundError:
             return None, "no manifest (interrupted write)"
-        except ValueError as exc:
+        except ValueError as exc:  # FileFormatError too: a FIFO, a device, too large
             return None, f"unreadable manifest ({_why(exc)})"
         if not isinstance(manifest, dict) or manifest.get("key") != key:
             return None, "manifest of another entry (foreign)"
@@ -123,6 +128,15 @@ def read_entry(folder, key: str) -> tuple[Superelement | None, str | None]:
         return None, f"cannot read ({_why(exc)})"
     except (ValueError, LookupError, TypeError, EOFError) as exc:  # rejected by the loader
         return None, f"not a valid superelement file ({_why(exc)})"
+
+
+def _read_manifest(path: Path) -> str:
+    """The manifest's text, from a regular file of at most :data:`MAX_MANIFEST` bytes."""
+    with open_regular(path, "cache manifest") as stream:
+        data = stream.read(MAX_MANIFEST + 1)
+    if len(data) > MAX_MANIFEST:
+        raise FileFormatError(f"{path}: more than {MAX_MANIFEST} bytes, not a cache manifest")
+    return data.decode("utf-8")
 
 
 def write_entry(folder, key: str, se: Superelement, label: str) -> Path:

@@ -41,7 +41,7 @@ from femmech.errors import ModelWarning
 from femmech.fe.dofs import COMPONENTS, components
 from femmech.fe.model import node_indices
 from femmech.output.formatting import Quantity, format_value
-from femmech.output.report import Section, Table
+from femmech.output.report import Flagged, Section, Table
 from femmech.reduction.component_modes import CUTOFF_FACTOR
 from femmech.scene import units
 from femmech.scene.cache_folder import default_cache_dir
@@ -292,7 +292,7 @@ def _selection_text(r) -> str:
     return f"{r.n_modes} lowest fixed-interface modes"
 
 
-def _estimate(se, model, r) -> str:
+def _estimate(se, model, r) -> str | Flagged:
     """The largest a-posteriori relative frequency error estimate of the superelement's
     own modes up to its frequency of interest (or of its lowest modes), as text."""
     top = r.f_max_hz if r.f_max_hz is not None else (
@@ -313,8 +313,15 @@ def _estimate(se, model, r) -> str:
     if not est.size:
         return f"no mode up to {format_value(top, 'Hz', trim=True)}"
     k = int(np.argmax(est))
-    return (f"{format_value(float(est[k]), digits=2)} (largest of {scope}, at"
+    text = (f"{format_value(float(est[k]), digits=2)} (largest of {scope}, at"
             f" {format_value(float(result.freq_hz[k]), 'Hz')})")
+    if result.n_unconfirmed:
+        bad = np.flatnonzero(~result.index_confirmed)
+        text += (f"; index unconfirmed for mode(s) {', '.join(str(int(j) + 1) for j in bad)}"
+                 " (Sturm count of the full model: the reduction missed a full mode below"
+                 " them, so their estimates compare with another full mode)")
+        return Flagged(text)
+    return text
 
 
 def _reduction_column(ws, name: str, r, model) -> tuple:

@@ -131,15 +131,23 @@ def run_modes(ws, spec, out):
                                progress=lambda it: progress(it, "mode images", ws.bars))
         figures += [Figure(p.name, f"mode {i + 1}: {result.freq_hz[i]:.3f} Hz")
                     for i, p in enumerate(paths)]
-    est = result.error_estimate
+    est, confirmed = result.error_estimate, result.index_confirmed
     header = ("mode", "frequency (Hz)", "rigid") + (("estimated rel. error",) if est is not
-                                                    None else ())
+                                                    None else ()) + (
+        ("index vs full",) if confirmed is not None else ())
     rows = tuple((i + 1, Quantity(float(f), digits=6), "yes" if r else "no")
                  + ((Quantity(float(est[i]), digits=2),) if est is not None else ())
+                 + ((_index_cell(confirmed[i]),) if confirmed is not None else ())
                  for i, (f, r) in enumerate(zip(result.freq_hz, result.rigid, strict=True)))
     solver = f", factorisation {result.solver}" if result.solver else ""
     text = (f"Part {spec.part!r}, {spec.model} model ({result.method} solver{solver}):"
             f" {result.n_modes} modes.",)
+    if result.n_unconfirmed:
+        text += (f"{result.n_unconfirmed} reduced mode(s) marked unconfirmed: a Sturm count"
+                 " of the full model shows that the full mode of the same number lies below"
+                 " the error estimate (the reduction missed a mode below them); their"
+                 " estimates compare with another full mode. Keep more fixed-interface"
+                 " modes.",)
     extra = {}
     if spec.discretisation_error:  # opt-in: one h/2 refinement of the full model
         with ws.timed("discretisation estimate"):
@@ -161,6 +169,12 @@ def run_modes(ws, spec, out):
                       tuple(figures), tuple(files), gallery=True)
     return section, {"part": spec.part, "model": spec.model, "freq_hz": _list(result.freq_hz),
                      **extra}
+
+
+def _index_cell(confirmed):
+    """The index cell of a reduced mode: confirmed by the full model's Sturm count or
+    flagged."""
+    return "confirmed" if confirmed else Flagged("unconfirmed")
 
 
 def run_sweep(ws, spec, out):
@@ -429,13 +443,17 @@ def run_check(ws, spec, out):
         e, m = float(np.abs(c.rel_error).max()), float(c.diag_mac.min())
         rows.append((f"f_max {f_max:g} Hz", system.n, 1e3 * c.seconds_reduced, e, m))
         levels.append({"f_max_hz": f_max, "n": system.n, "max_rel_error": e, "min_mac": m})
+    matches = matched_full_modes(comp)
     tables = [Table("Reduced versus full at the check angles", ("angle (°)", "mode",
                                                                "full (Hz)", "reduced (Hz)",
-                                                               "rel. error", "MAC"),
+                                                               "rel. error", "MAC",
+                                                               "matches full mode"),
                     tuple((f"{np.rad2deg(a):.1f}", j + 1,  # 8 digits: the error is ~1e-7
                            Quantity(float(comp.freq_full_hz[i, j]), digits=8),
                            Quantity(float(comp.freq_reduced_hz[i, j]), digits=8),
-                           f"{comp.rel_error[i, j]:.2e}", f"{comp.diag_mac[i, j]:.8f}")
+                           f"{comp.rel_error[i, j]:.2e}", f"{comp.diag_mac[i, j]:.8f}",
+                           j + 1 if matches[i, j] == j else
+                           Flagged(f"{matches[i, j] + 1}: index unconfirmed"))
                           for i, a in enumerate(comp.phi) for j in k)),
               Table("Speed versus error", ("model", "coordinates", "ms per angle",
                                            "max |rel. error|", "min MAC"),
@@ -449,9 +467,32 @@ def run_check(ws, spec, out):
     text = (f"Superelement of part {part!r}: {se.n_reduced} coordinates (full model"
             f" {len(se.free_interface) + len(se.free_interior)} free DOFs); max |rel. error|"
             f" {err:.2e}, min MAC {mac:.8f} at {comp.phi.size} angles.",)
+    off = np.count_nonzero(matches != k)
+    if off:
+        text += (f"{off} reduced mode(s) resemble another full mode (largest MAC) that is"
+                 " also nearer in frequency than the full mode of the same number: the"
+                 " reduction missed a full mode below them, so their rows compare different"
+                 " modes (marked 'index unconfirmed'). Keep more fixed-interface modes.",)
     section = Section("Reduced versus full", text, tuple(tables), tuple(figures), tuple(files))
     return section, {"rel_error": _list(comp.rel_error), "diag_mac": _list(comp.diag_mac),
                      "max_rel_error": err, "min_mac": mac, "levels": levels}
+
+
+def matched_full_modes(comp: Comparison) -> np.ndarray:
+    """The full mode (0-based) that each reduced mode is, (n_angles, n_modes) of int.
+
+    Reduced mode k is full mode k unless another full mode j has the largest MAC with it
+    and lies nearer to its frequency than full mode k: then the reduction missed a full
+    mode below, and the row of mode k compares two different modes. A largest MAC off the
+    diagonal alone is not enough (the pairs of a symmetric frame mix freely).
+    """
+    n = comp.freq_full_hz.shape[1]
+    same = np.arange(n)
+    best = np.argmax(comp.mac, axis=2)
+    f_red, f_full = comp.freq_reduced_hz, comp.freq_full_hz
+    own = np.abs(f_red / f_full - 1.0)
+    other = np.abs(f_red / np.take_along_axis(f_full, best, axis=1) - 1.0)
+    return np.where((best != same) & (other < own), best, same)
 
 
 def _plot_speed_error(rows, path) -> None:
