@@ -50,6 +50,7 @@ def test_nearly_massless_unit_keeps_its_roots():
     assert np.allclose(modes.freq_hz[1:3], np.sqrt(2e5 / 0.5) / (2 * np.pi), rtol=1e-6)
     # eigh's error on the lowest root is ~eps λ_max / λ_1 ≈ 1e-16 · 6.6e8 / 0.09 ≈ 1e-6
     assert np.allclose(modes.omega2, lam, rtol=1e-5)
+    # bound: bisection rtol 1e-12; eigh eps·λ_max/λ ≈ 1e-16 · 6.6e8 / 4e5 ≈ 2e-13 on these
     assert np.allclose(modes.omega2[1:], lam[1:], rtol=1e-10)
 
 
@@ -86,6 +87,7 @@ def test_badly_scaled_units_agree_with_the_assembled_count(name):
     assert len(modes) == ch.n
     # eigh's absolute error ~eps λ_max (a relative eps λ_max / λ on each root: up to ~1e-6
     # on the soft ones next to a 2e13 N/m spring); the transfer roots to rtol 1e-12
+    # bound: bisection rtol 1e-12 on λ plus eigh's absolute eps·λ_max
     tol = 1e-9 * np.abs(lam) + 100 * np.finfo(float).eps * np.abs(lam).max()
     assert np.all(np.abs(modes.omega2 - lam) <= tol)
     # W–W count against the assembled Sturm count between and around every root
@@ -110,6 +112,7 @@ def test_massless_node_has_no_root():
     # references: rigid rotation 0; the follower √(c/m); the outer nodes antisymmetric,
     # the middle node massless and at rest: λ = k / J (the middle node is a fixed point)
     assert modes.freq_hz[0] == 0.0
+    # bound: bisection rtol 1e-12 on λ (references exact: c/m and k/J)
     assert np.allclose(modes.omega2[1:], np.sort([2e5 / 0.5, 8e4 / 1e-2]), rtol=1e-10)
 
 
