@@ -116,6 +116,10 @@ def _drop(path):
     (_set(("chain", "unit", "mass"), "0 kg"), "[chain.unit] mass: expected a positive"),
     (_set(("chain", "unit", "stiffness"), "3e5 N*m/rad"),
      "[chain.unit] stiffness: expected a stiffness"),
+    (_set(("chain", "unit", "ground_stiffness"), "-1 N/m"),
+     "[chain.unit] ground_stiffness: expected a"),
+    (_set(("chain", "unit", "ground_stiffness"), "2e4 N*m/rad"),
+     "[chain.unit] ground_stiffness: expected a stiffness"),
     (_set(("chain", "unit", "cam", "law"), "sine"), "[chain.unit.cam] law: expected one of"),
     (_set(("chain", "unit", "cam", "rise"), "100 deg"),
      "[chain.unit.cam]: rise + dwell_top + return + dwell_bottom = 340 deg"),
@@ -173,6 +177,21 @@ def test_scene_chain_equals_the_api_chain():
     assert_allclose(np.diag(stiffer.C(0.0))[stiffer.unit_dofs[:, 1]], 4e5)
     with pytest.raises(ValueError, match="unknown design parameter 'diameter'"):
         build_chain(scene.chain, {"diameter": 0.05})
+
+
+def test_scene_follower_ground_spring():
+    """``[chain.unit] ground_stiffness`` is follower_unit's c_g (N/m): same matrices."""
+    data = small()
+    data["chain"]["unit"]["ground_stiffness"] = "4e4 N/m"
+    built = prepare(Scene.from_dict(data, EXAMPLES, "s.toml")).chain
+    cam = cam_program(0.03, rise=120, dwell_top=60, return_=120, dwell_bottom=60,
+                      law="modified_sine")
+    api = chain(follower_unit(cam, 2e-3, 0.6, 3e5, 10.0, c_g=4e4), 5, 0.25, 0.05,
+                phases=2 * np.pi * np.arange(5) / 5, left=End.elastic(5e3), cells=True)
+    for phi in (0.0, 1.3):
+        assert_allclose(built.C(phi), api.C(phi), rtol=1e-15, atol=0)  # bound: same inputs, exact
+    # the follower's diagonal holds c + c_g; bound: one sum, exact to 1 ulp
+    assert_allclose(np.diag(built.C(0.0))[built.unit_dofs[:, 1]], 3e5 + 4e4, rtol=1e-15)
 
 
 def test_small_chain_scene_runs_end_to_end(tmp_path):
