@@ -97,7 +97,7 @@ def _modes(chain, phi, count, method, vectors=True) -> ChainModes:
         return cyclic_modes(chain, phi, vectors=vectors)
     from femmech.chain.continuum import continuum_modes
 
-    return continuum_modes(chain, phi, count, vectors=vectors)
+    return continuum_modes(chain, phi, count, vectors=vectors, estimate=False, warn=False)
 
 
 def _lambda_columns(freq_hz):
