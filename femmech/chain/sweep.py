@@ -41,12 +41,12 @@ def chain_sweep(chain, phi, n_modes: int, method: str = "transfer",
     phi : array_like (n_angles,)
         Drive angles, rad, in sweep order (e.g. ``np.linspace(0, 2π, 181)``).
     n_modes : int
-        Branches wanted: every branch that is among the n_modes lowest roots at *some*
-        angle is returned (the n lowest at the first angle, then, in the order they
-        enter, those that become one of the n lowest later), so ``freq_hz`` may have
-        more than n_modes columns. MAC tracking follows more branches than asked for
-        and repeats the sweep with twice as many where a root below the n-th lowest
-        was not among them.
+        The n lowest roots at *every* angle, in n columns: a branch keeps its column
+        while it is among the n lowest; when one leaves and another (from above) enters,
+        the column passes to the entering branch and ``mac_step`` is 0 there. Tracking
+        follows more branches than n (MAC: the sweep is repeated with twice as many
+        where a root below the n-th lowest was not among them), so no root among the n
+        lowest is missed at any angle.
     method : str
         One of :data:`METHODS`.
     frequency_weight : float
@@ -59,7 +59,8 @@ def chain_sweep(chain, phi, n_modes: int, method: str = "transfer",
     Sweep
         ``form="symmetric"``; ``freq_hz`` = Re √λ / 2π (0 and damping ratio −1 for a
         root λ < 0: divergence); ``mac_step``: MAC (subspace MAC in clusters) of each
-        branch with itself at the previous angle (label tracking: the MAC of the same
+        branch with itself at the previous angle (0 where the column passes to another
+        branch) (label tracking: the MAC of the same
         label's vectors if the method has vectors, else 1); NaN where a label-tracked
         branch is absent at an angle.
     """
@@ -117,10 +118,36 @@ def _mac_sweep(chain, phi, n_modes, method, weight, keep_vectors) -> Sweep:
         if out is not None or tracked == chain.n:
             break
         tracked = min(2 * tracked, chain.n)
-    lam, freq, ratio, mac_step, vectors, low = out
-    keep = low.any(axis=0)  # branches among the n lowest at some angle
-    return Sweep(phi, freq[:, keep], lam[:, keep], ratio[:, keep],
-                 None if vectors is None else vectors[:, :, keep], mac_step[:, keep],
+    return _lowest_columns(phi, *out, n_modes)
+
+
+def _lowest_columns(phi, lam, freq, ratio, mac_step, vectors, low, n_modes) -> Sweep:
+    """The Sweep of the ``n_modes`` lowest roots at every angle from tracked branches
+    (n_angles, b) with ``low`` True where a branch is among the n lowest: a branch keeps
+    its column while it stays among them; a column whose branch leaves passes to a branch
+    that enters (lowest first), with ``mac_step`` 0 at that angle."""
+    n_angles = phi.size
+    cols = np.full((n_angles, n_modes), -1)
+    order = np.argsort(np.where(low[0], np.nan_to_num(freq[0], nan=np.inf), np.inf),
+                       kind="stable")
+    cols[0] = order[:n_modes]
+    switched = np.zeros((n_angles, n_modes), bool)
+    for a in range(1, n_angles):
+        here = np.flatnonzero(low[a])
+        here = here[np.argsort(np.nan_to_num(freq[a, here], nan=np.inf), kind="stable")]
+        here = here[:n_modes]
+        stay = np.isin(cols[a - 1], here)
+        cols[a] = np.where(stay, cols[a - 1], -1)
+        entering = [b for b in here if b not in cols[a]]
+        free = np.flatnonzero(cols[a] < 0)
+        for c, b in zip(free, entering, strict=False):
+            cols[a, c] = b
+            switched[a, c] = True
+        cols[a, cols[a] < 0] = cols[a - 1, cols[a] < 0]  # (fewer than n roots: keep)
+    rows = np.arange(n_angles)[:, None]
+    macs = np.where(switched, 0.0, mac_step[rows, cols])
+    vec = None if vectors is None else np.take_along_axis(vectors, cols[:, None, :], axis=2)
+    return Sweep(phi, freq[rows, cols], lam[rows, cols], ratio[rows, cols], vec, macs,
                  "symmetric")
 
 
@@ -219,6 +246,7 @@ def _label_sweep(chain, phi, n_modes, method, keep_vectors) -> Sweep:
             if key not in keys:
                 keys.append(key)
     n_branches = len(keys)
+    low = np.zeros((n_angles, n_branches), bool)
     lam = np.full((n_angles, n_branches), np.nan, dtype=complex)
     freq = np.full((n_angles, n_branches), np.nan)
     ratio = np.zeros((n_angles, n_branches))
@@ -231,6 +259,8 @@ def _label_sweep(chain, phi, n_modes, method, keep_vectors) -> Sweep:
         where = {key: i for i, key in enumerate(found)}
         idx = np.array([where.get(key, -1) for key in keys])
         ok = idx >= 0
+        lowest = set(found[:n_modes])
+        low[a] = [key in lowest for key in keys]
         lam[a, ok], freq[a, ok], ratio[a, ok] = _lambda_columns(modes.freq_hz[idx[ok]])
         V = None if modes.vectors is None else np.full((n, n_branches), np.nan)
         if V is not None:
@@ -240,7 +270,7 @@ def _label_sweep(chain, phi, n_modes, method, keep_vectors) -> Sweep:
             previous = V
             if keep_vectors:
                 vectors[a] = V
-    return Sweep(phi, freq, lam, ratio, vectors, mac_step, "symmetric")
+    return _lowest_columns(phi, lam, freq, ratio, mac_step, vectors, low, n_modes)
 
 
 def _keys(label) -> list[tuple[int, int]]:

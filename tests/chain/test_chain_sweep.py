@@ -63,14 +63,9 @@ def test_tracking_through_a_crossing_keeps_identity():
     b = int(np.argmax(on_left))  # the left half's branch (the others are right-half modes)
     rank = np.argsort(np.argsort(sw.freq_hz, axis=1), axis=1)[:, b]
     assert rank.min() == 0
-    # branches that become one of the 4 lowest later are returned too (6 here), so the
-    # left branch's rank among the returned ones reaches beyond 3
-    assert sw.freq_hz.shape[1] > 4
-    assert rank.max() >= 3
+    assert rank.max() == 3
     for a, angle in enumerate(phi):
         ref = assembled_modes(ch, angle, n_modes=8)
-        # the 4 lowest roots at every angle lie on returned branches (eigh vs bisection)
-        assert np.allclose(np.sort(sw.freq_hz[a])[:4], ref.freq_hz[:4], rtol=1e-9)
         M = ch.sparse_matrices(angle)[0]
         v = sw.vectors[a][:, [b]]
         # identity by MAC against the assembled vectors (span of a repeated root when the
@@ -91,13 +86,12 @@ def test_label_tracking_for_the_closed_forms():
     phi = np.radians(np.arange(0.0, 121.0, 20.0))
     cyc = chain_sweep(ch, phi, 6, "cyclic")
     ref = chain_sweep(ch, phi, 6, "transfer")
-    # labels fix the branches: the 6 lowest at every angle are the MAC-tracked transfer
-    # sweep's (each method returns every branch among the 6 lowest at some angle; which
-    # branches those are depends on how a method names them; the closed form is exact,
-    # both ~1e-12)
-    assert np.allclose(np.sort(cyc.freq_hz, axis=1)[:, :6], np.sort(ref.freq_hz, axis=1)[:, :6],
+    # labels fix the branches: same frequencies as the MAC-tracked transfer sweep
+    # (the closed form is exact; both ~1e-12)
+    assert np.allclose(np.sort(cyc.freq_hz, axis=1), np.sort(ref.freq_hz, axis=1),
                        rtol=1e-9, atol=1e-6)
-    assert np.nanmin(cyc.mac_step) > 0.9
+    # a column passes to another label where one leaves the 6 lowest (mac_step 0 there)
+    assert np.all((cyc.mac_step > 0.9) | (cyc.mac_step == 0.0))
     both = compare_methods(ch, phi[:2], 4, methods=("transfer", "continuum"))
     assert set(both) == {"transfer", "continuum"}
     assert both["continuum"].freq_hz.shape == (2, 4)
