@@ -38,7 +38,18 @@ End conditions (``ends``):
   root l bracketed in ``[lπ/N, (l + 1)π/N)``. It puts the spring half a cell further
   out than the chain does, an O(1/N) difference in μ for grounded ends.
 
-Stage 6 (chain): numpy/scipy; imports the chain's cyclic helpers and result type.
+Phased units (``smearing="impedance"``, the default): the units' exact dynamic stiffness
+on their nodes, d_u(λ) (the condensation of :mod:`.transfer`), is averaged instead of
+their matrices; per wave ``k μ_j² − λ J + d̄(λ) = 0``. It does not depend on the units'
+internal coordinates; ``smearing="matrices"`` (the mean M̄, C̄ above) does, for phased
+units. Validity conditions (:func:`validity_problems`): μ_j ≤ :data:`MU_VALID`; for phased
+units f ≤ :data:`FREQ_VALID` × the lowest internal frequency and a spread of the units'
+static stiffness d_u(0) ≤ :data:`SPREAD_VALID` × k μ_j². ``continuum_modes`` returns an
+error estimate (``ChainModes.error``, against the transfer-matrix roots) and warns
+(ModelWarning) outside the range.
+
+Stage 6 (chain): numpy/scipy; imports the chain's cyclic helpers, the transfer method's
+unit condensation (error estimate) and result type.
 """
 
 from __future__ import annotations
