@@ -55,11 +55,13 @@ def test_end_conditions_symbolic():
     res = sp.expand_trig(Th.subs(s, -1) - (1 - g) * Th.subs(s, 0))
     res = sp.simplify(res.rewrite(sp.cos))
     for gv, mv in ((0.3, 0.7), (1.7, 2.5), (0.0, 1.1), (1.0, 0.4)):
+        # bound: float evaluation of an exact sympy identity: ~1e-16
         assert abs(float(res.subs({g: gv, mu: mv}))) < 1e-14
     # g = 0 → Θ = cos(μ(s + ½)) (Θ' = 0 half a cell out); g = 1 → sin(μ(s + 1)) (clamp)
     for gv, shape in ((0, sp.cos(mu * (s + sp.Rational(1, 2)))), (1, sp.sin(mu * (s + 1)))):
         for mv in (0.3, 1.2, 2.9):
             d = (Th - shape).subs({g: gv, mu: mv})
+            # bound: as above
             assert all(abs(float(d.subs(s, sv))) < 1e-14 for sv in (0, 1, 3.5))
     # shaft form: Θ = cos(μ x̃ − α), tan α = g/μ meets GJ Θ'(0) = k_g Θ(0), x̃ = x/a
     xt = sp.symbols("xt")
@@ -79,17 +81,20 @@ def test_cell_ends_reproduce_the_chain_wave_numbers(gl, gr):
         L[0, 0], L[-1, -1] = 1 + gl, 1 + gr
         assert mu.size == N
         assert labels[0] == 1
+        # bound: eigvalsh of a small Laplacian: ~N eps
         assert np.allclose(2 - 2 * np.cos(mu), np.linalg.eigvalsh(L), atol=1e-13)
 
 
 def test_closed_forms_and_shaft_ends():
     for case, g in (("free-free", (0, 0)), ("grounded-free", (1, 0)),
                     ("grounded-grounded", (1, 1))):
+        # bound: closed forms vs brentq (xtol 1e-15)
         assert np.allclose(mode_wave_numbers(9, *g, 9)[1], wave_numbers(9, case)[1],
                            rtol=1e-15)
     # shaft form: μ N − atan(g_L/μ) − atan(g_R/μ) = lπ, root l in [lπ/N, (l+1)π/N)
     labels, mu = mode_wave_numbers(12, 0.8, 0.0, 5, ends="shaft")
     h = mu * 12 - np.arctan(0.8 / mu)
+    # bound: brentq xtol 1e-15 on μ; the residual h(μ) to ~1e-13
     assert np.allclose(h, np.pi * np.arange(5), atol=1e-12)
     assert labels.tolist() == [1, 2, 3, 4, 5]
 
@@ -107,12 +112,14 @@ def test_dwell_shaft_branch_error_is_the_dispersion_error(unit, case):
     cy = cyclic_modes(ch, PHI_DWELL, vectors=False)
     co = continuum_modes(ch, PHI_DWELL, ch.n, vectors=False, estimate=False, warn=False)
     labels, mu = wave_numbers(40, case)
+    # bound: the dwell root c/m: eigh ~1e-15 on the 2×2 problem
     shaft = ~np.isclose(cy.freq_hz, F_FOLLOWER, rtol=1e-9)
     checked = 0
     for j, m_ in zip(labels, mu, strict=True):
         if not 0.05 < m_ <= 1.0:
             continue
         fd = cy.freq_hz[(cy.label == j) & shaft]
+        # bound: as above
         fc = co.freq_hz[(co.label == j) & ~np.isclose(co.freq_hz, F_FOLLOWER, rtol=1e-9)]
         err = fc[0] / fd[0] - 1
         assert err == pytest.approx(np.sqrt(m_**2 / (2 - 2 * np.cos(m_))) - 1, rel=1e-9)
@@ -151,6 +158,7 @@ def test_uniform_continuum_vectors_are_the_chain_shapes(unit):
     M, C = ch.M(PHI_RISE), ch.C(PHI_RISE)
     lam, V = sl.eigh(C, M)
     co = continuum_modes(ch, PHI_RISE, 8, estimate=False, warn=False)
+    # bound: normalised with the same M: ~1e-15
     assert np.allclose(np.einsum("ik,ij,jk->k", co.vectors, M, co.vectors), 1, rtol=1e-12)
     mac = (co.vectors.T @ M @ V) ** 2          # (8, n), V M-normalised
     assert np.all(mac.max(axis=1) > 0.999)
@@ -226,6 +234,7 @@ def test_error_table(unit):
     # √(μ²/(2 − 2 cos μ)) − 1 (≈ μ²/24; coupling to the follower only lowers it)
     ok = ~np.isnan(worst)
     mu = t.mu[ok]
+    # bound: float rounding of the dispersion bound
     assert np.all(worst[ok] <= (np.sqrt(mu**2 / (2 - 2 * np.cos(mu))) - 1) * (1 + 1e-9))
     assert np.all(worst[ok] >= 0.5 * mu**2 / 24)
     assert "| 40 |" in t.markdown()

@@ -126,6 +126,7 @@ def test_ks_formula_sympy():
                             np.array(hi, float), 40.0)
     assert value == pytest.approx(float(ks.subs(point)), rel=1e-12)
     exact = [float(sympy.diff(ks, f).subs(point)) for f in (f1, f2)]
+    # bound: analytic derivative vs sympy: round-off ~1e-14
     np.testing.assert_allclose(grad[0], exact, rtol=1e-10)
     # the nested form: exp(-ρ smoothmax(a, b)) = 1/(e^{ρa} + e^{ρb})
     a, b = sympy.symbols("a b", real=True)
@@ -147,7 +148,9 @@ def test_fox_kapoor_sympy():
     w, V = frozen_eigen(Mn[None], Cn[None])
     fk = [V[0, :, i] @ (dC - w[0, i] * dM) @ V[0, :, i] for i in range(2)]
     by_root = sorted(zip((float(r.subs(p, p0)) for r in roots), exact, strict=True))
+    # bound: eigh vs sympy roots: ~1e-15
     np.testing.assert_allclose(w[0], [r for r, _ in by_root], rtol=1e-12)
+    # bound: Fox–Kapoor vs sympy: ~1e-13
     np.testing.assert_allclose(fk, [d for _, d in by_root], rtol=1e-10)
 
 
@@ -156,6 +159,7 @@ def test_one_dof_frequency_sympy():
     k, J, lam = sympy.symbols("k J lambda", positive=True)
     assert sympy.solve(k - lam * J, lam) == [k / J]
     bands = frequency_bands(one_dof(400.0, 0.25))
+    # bound: eigh of a 1×1 problem: exact to ~1e-16
     np.testing.assert_allclose(bands.freq_hz, np.sqrt(400 / 0.25) / TWO_PI, rtol=1e-13)
 
 
@@ -185,6 +189,7 @@ def test_gradient_through_a_cluster_of_repeated_eigenvalues():
         return chain(follower_unit(CAM, 1e-3, 0.5, v["c"]), 5, 0.2, 0.03,
                      left=End.elastic(1e4, v["J"]))
     f = frequency_bands(in_phase({"J": 0.05, "c": 2e5}), n_angles=6).freq_hz[0]
+    # bound: a repeated root from identical units in phase: eigh splits it by ~1e-13
     assert np.ptp(f[1:5]) < 1e-9 * f[1]  # the cluster is there
     values = {"J": 0.05, "c": 2.1e5}  # f cluster ≈ 103 Hz: KS dominated by it (band 4)
     ks, grad, _ = margin_sensitivities(in_phase, PARAMS, values, SPEED, K, n_angles=12)
