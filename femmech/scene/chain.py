@@ -49,8 +49,8 @@ from femmech.scene.units import (
 )
 
 MAX_UNITS = 10_000
-"""Most units of a chain (the assembled model is solved densely up to 2000 coordinates,
-then sparse; the transfer method is O(N))."""
+"""Most units of a chain (the assembled model is solved densely below 400 coordinates,
+then sparse: :data:`femmech.chain.transfer.DENSE_MAX`; the transfer method is O(N))."""
 MAX_HARMONICS = 100
 """Highest drive harmonic k·Ω of a Campbell diagram or a synthesis."""
 MAX_STARTS = 64
