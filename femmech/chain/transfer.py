@@ -85,8 +85,10 @@ than 4 brackets: a pass evaluates about 4 × MULTISECTION frequencies at most pe
 group, so few brackets converge in few passes over the N nodes)."""
 
 ZERO_RTOL = 1e-14
-"""Roots with |λ| below this times the largest node/unit eigenvalue ratio are zero
-(rigid-body); the count's round-off near λ = 0 is about 1e-16 of that scale."""
+"""Roots with |λ| below this times the chain's eigenvalue scale (:func:`_eigenvalue_scale`:
+the trace ratio of C and M over the node rotations) are zero (rigid-body); the count's
+round-off near λ = 0 is about 1e-16 of that scale. Roots reported as zero are checked
+(:data:`ZERO_CHECK`)."""
 
 DENSE_MAX = 400
 """``assembled_modes(solver="auto")`` uses dense LAPACK below this many coordinates (and
@@ -390,8 +392,8 @@ def transfer_modes(chain, phi: float, n_modes: int | None = None, f_max: float |
         All roots below f_max, Hz (with n_modes too: at most n_modes of them).
     rtol : float
         Relative width of the final bracket of each root in λ = ω². Roots with
-        ``|λ| <= ZERO_RTOL`` times the largest node/unit eigenvalue (rigid-body roots,
-        where the count is round-off) stop there.
+        ``|λ| <= ZERO_RTOL`` times the chain's eigenvalue scale (rigid-body roots,
+        where the count is round-off) stop there and are reported as 0 (checked).
     vectors : bool
         Compute the modes (assembled coordinates, M-normalised, M-orthogonal within
         repeated roots).
