@@ -128,3 +128,18 @@ def test_a_root_that_does_not_verify_is_flagged(monkeypatch):
     assert zero.any()
     assert not modes.converged[zero].any()
     assert "UNCONVERGED" in repr(modes)
+
+
+def test_a_count_that_disagrees_with_the_assembled_sturm_count_is_flagged(monkeypatch):
+    # simulate a Wittrick–Williams count gone wrong (the assembled Sturm count one higher
+    # at every cut): every root is flagged and a warning names the cut
+    unit = follower_unit(CAM, 2e-3, 0.5, 2e5)
+    ch = chain(unit, 4, SPACING, DIAMETER, phases=[0.0, 1.0, 2.0, 3.0], left=End.fixed())
+    real = tr._sturm_counts
+    monkeypatch.setattr(tr, "_sturm_counts", lambda M, C, cuts: [
+        None if c is None else c + 1 for c in real(M, C, cuts)])
+    with pytest.warns(ConvergenceWarning, match="Sturm count"):
+        modes = transfer_modes(ch, 0.4, n_modes=3)
+    assert not modes.converged.any()
+    # without the check (verify=False) nothing is compared
+    assert transfer_modes(ch, 0.4, n_modes=3, verify=False).converged.all()
