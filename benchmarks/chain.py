@@ -91,7 +91,8 @@ def methods() -> dict:
         "transfer": lambda ch, k: transfer_modes(ch, PHI, n_modes=k, vectors=False).freq_hz,
         "transfer + vectors": lambda ch, k: transfer_modes(ch, PHI, n_modes=k).freq_hz,
         "cyclic": lambda ch, k: cyclic_modes(ch, PHI, vectors=False).freq_hz[:k],
-        "continuum": lambda ch, k: continuum_modes(ch, PHI, k, vectors=False).freq_hz,
+        "continuum": lambda ch, k: continuum_modes(ch, PHI, k, vectors=False, estimate=False,
+                                                   warn=False).freq_hz,
     }
 
 

@@ -116,6 +116,10 @@ def _drop(path):
     (_set(("chain", "unit", "mass"), "0 kg"), "[chain.unit] mass: expected a positive"),
     (_set(("chain", "unit", "stiffness"), "3e5 N*m/rad"),
      "[chain.unit] stiffness: expected a stiffness"),
+    (_set(("chain", "unit", "ground_stiffness"), "-1 N/m"),
+     "[chain.unit] ground_stiffness: expected a"),
+    (_set(("chain", "unit", "ground_stiffness"), "2e4 N*m/rad"),
+     "[chain.unit] ground_stiffness: expected a stiffness"),
     (_set(("chain", "unit", "cam", "law"), "sine"), "[chain.unit.cam] law: expected one of"),
     (_set(("chain", "unit", "cam", "rise"), "100 deg"),
      "[chain.unit.cam]: rise + dwell_top + return + dwell_bottom = 340 deg"),
@@ -166,9 +170,9 @@ def test_scene_chain_equals_the_api_chain():
     api = chain(follower_unit(cam, 2e-3, 0.6, 3e5, 10.0), 5, 0.25, 0.05,
                 phases=2 * np.pi * np.arange(5) / 5, left=End.elastic(5e3), cells=True)
     for phi in (0.0, 1.3):
-        # bound: the same matrices built by two paths: identical arithmetic
+        # bound: the same inputs through the same arithmetic: exact up to unit conversion (1 ulp)
         assert_allclose(built.M(phi), api.M(phi), rtol=1e-15, atol=0)
-        # bound: the same matrices built by two paths: identical arithmetic
+        # bound: as above
         assert_allclose(built.C(phi), api.C(phi), rtol=1e-15, atol=0)
     # a design value overrides the scene's: the follower stiffness is C's internal diagonal
     stiffer = build_chain(scene.chain, {"follower_stiffness": 4e5})
@@ -177,12 +181,28 @@ def test_scene_chain_equals_the_api_chain():
         build_chain(scene.chain, {"diameter": 0.05})
 
 
+def test_scene_follower_ground_spring():
+    """``[chain.unit] ground_stiffness`` is follower_unit's c_g (N/m): same matrices."""
+    data = small()
+    data["chain"]["unit"]["ground_stiffness"] = "4e4 N/m"
+    built = prepare(Scene.from_dict(data, EXAMPLES, "s.toml")).chain
+    cam = cam_program(0.03, rise=120, dwell_top=60, return_=120, dwell_bottom=60,
+                      law="modified_sine")
+    api = chain(follower_unit(cam, 2e-3, 0.6, 3e5, 10.0, c_g=4e4), 5, 0.25, 0.05,
+                phases=2 * np.pi * np.arange(5) / 5, left=End.elastic(5e3), cells=True)
+    for phi in (0.0, 1.3):
+        assert_allclose(built.C(phi), api.C(phi), rtol=1e-15, atol=0)  # bound: same inputs, exact
+    # the follower's diagonal holds c + c_g; bound: one sum, exact to 1 ulp
+    assert_allclose(np.diag(built.C(0.0))[built.unit_dofs[:, 1]], 3e5 + 4e4, rtol=1e-15)
+
+
 def test_small_chain_scene_runs_end_to_end(tmp_path):
     result = run_scene(Scene.from_dict(small(), EXAMPLES, "small.toml"), tmp_path / "out",
                        cache_dir=None)
     r = result.results
-    # bound: transfer matrices and the assembled model solve the same frozen problem: they agree
+    # transfer matrices and the assembled model solve the same frozen problem: they agree
     # to the roots' tolerance (1e-12 relative, transfer_modes' rtol), 1e-9 demanded
+    # bound: both solve the same problem: bisection rtol 1e-12 vs eigh ~1e-13
     assert r["chain_sweep"]["max_rel_difference"]["transfer"] < 1e-9
     # the continuum differs by its dispersion error, about μ²/24 for the shaft modes
     # (docstring of femmech.chain.continuum): a few percent for 5 cells, not more
@@ -217,15 +237,15 @@ def test_example_scene_matches_the_example_script():
     module = _example()
     scene = load_scene(EXAMPLES / "knitting_machine_chain.toml")
     built, api = prepare(scene).chain, module.build(module.INITIAL)
-    # bound: the same matrices built by two paths: identical arithmetic
+    # bound: the same inputs, one unit conversion: 1 ulp
     assert_allclose(built.M(0.7), api.M(0.7), rtol=1e-15, atol=0)
-    # bound: the same matrices built by two paths: identical arithmetic
+    # bound: as above
     assert_allclose(built.C(0.7), api.C(0.7), rtol=1e-15, atol=0)
     spec = scene.analyses.synthesis
     bounds = {n: (lo, hi) for n, lo, hi in spec.parameters}
     assert bounds.keys() == module.BOUNDS.keys()
     for name, (lo, hi) in module.BOUNDS.items():  # unit conversion: one rounding
-        # bound: unit conversion: one rounding (1.1e-16 relative)
+        # bound: one unit conversion: 1 ulp
         assert_allclose(bounds[name], (lo, hi), rtol=1e-15)
     assert spec.margin == module.MARGIN
     assert spec.harmonics == module.HARMONICS
@@ -237,7 +257,8 @@ def test_knitting_machine_example(tmp_path):
     synthesis that moves every quasi-eigenfrequency out of the harmonic bands (about a
     minute on one core)."""
     r = _example().main(tmp_path, n_angles=37, starts=2)
-    # bound: transfer = assembled to the root tolerance; measured 2.4e-13
+    # transfer = assembled to the root tolerance; measured 2.4e-13
+    # bound: bisection rtol 1e-12 vs eigh ~1e-13
     assert r["max_rel_difference"]["transfer"] < 1e-9
     # continuum: the smeared model's error for 28 cells and the 6 lowest branches,
     # measured 2.0e-2 (follower cluster smeared to one frequency); 5 % would flag a

@@ -7,7 +7,8 @@
 * :mod:`.sweep`: tracked sweeps over the drive angle by any method (``chain_sweep``,
   ``compare_methods``).
 * :mod:`.cyclic`: uniform chains in closed form per wave number (``cyclic_modes``).
-* :mod:`.continuum`: the smeared continuum (``continuum_modes``, ``continuum_error_table``).
+* :mod:`.continuum`: the smeared continuum (``continuum_modes`` with its error estimate,
+  ``continuum_error_table``, ``validity_problems``).
 * :mod:`.frame`: the chain's units on an elastic (reduced) machine frame (``mount_chain``).
 * :mod:`.synthesis`: design parameters that keep the quasi-eigenfrequencies out of the
   drive harmonics (``synthesise``, ``resonance_margin``).

@@ -38,7 +38,18 @@ End conditions (``ends``):
   root l bracketed in ``[lπ/N, (l + 1)π/N)``. It puts the spring half a cell further
   out than the chain does, an O(1/N) difference in μ for grounded ends.
 
-Stage 6 (chain): numpy/scipy; imports the chain's cyclic helpers and result type.
+Phased units (``smearing="impedance"``, the default): the units' exact dynamic stiffness
+on their nodes, d_u(λ) (the condensation of :mod:`.transfer`), is averaged instead of
+their matrices; per wave ``k μ_j² − λ J + d̄(λ) = 0``. It does not depend on the units'
+internal coordinates; ``smearing="matrices"`` (the mean M̄, C̄ above) does, for phased
+units. Validity conditions (:func:`validity_problems`): μ_j ≤ :data:`MU_VALID`; for phased
+units f ≤ :data:`FREQ_VALID` × the lowest internal frequency and a spread of the units'
+static stiffness d_u(0) ≤ :data:`SPREAD_VALID` × k μ_j². ``continuum_modes`` returns an
+error estimate (``ChainModes.error``, against the transfer-matrix roots) and warns
+(ModelWarning) outside the range.
+
+Stage 6 (chain): numpy/scipy; imports the chain's cyclic helpers, the transfer method's
+unit condensation (error estimate) and result type.
 """
 
 from __future__ import annotations
@@ -55,9 +66,37 @@ from femmech.chain.cyclic import (
     unit_branches,
     wave_numbers,
 )
+from femmech.chain.impedance import (
+    _impedance,
+    _impedance_roots,
+    _impedance_vectors,
+)
 from femmech.chain.results import ChainModes
 
 ENDS = ("cell", "shaft")
+
+SMEARINGS = ("impedance", "matrices")
+"""How the units are smeared (:func:`continuum_modes`)."""
+
+MU_VALID = 0.5
+"""Validity: wave numbers μ_j = β a (rad per cell) up to this; the dispersion error of the
+shaft-like modes is then below √(μ²/(2 − 2cos μ)) − 1 ≈ μ²/24 ≈ 1 %."""
+
+FREQ_VALID = 0.5
+"""Validity for phased units: frequencies up to this fraction of the lowest internal
+frequency of the units (√μ_min / 2π, the follower frequency). Measured maximum errors of
+the impedance smearing below it: docs/chain.md."""
+
+SPREAD_VALID = 0.1
+"""Validity for phased units whose static torsional stiffness on the node, d_u(0) (process
+force F U'', ground spring c_g), differs between units: the spread (standard deviation)
+of d_u(0) up to this fraction of the shaft stiffness κ_j = k μ_j² of a root's wave (the
+low modes then do not depend on where along the shaft the stiff and the soft units sit).
+Measured: std/κ = 0.07 gave 1.1 %, 0.34 gave 4.3 %, 2 gave 36 % on the lowest root."""
+
+ERROR_WARN = 0.01
+"""A ModelWarning is issued when the error estimate of a delivered root exceeds this
+(relative frequency error)."""
 
 
 @dataclass(frozen=True)
@@ -195,47 +234,165 @@ def mode_shapes(n_cells: int, mu: np.ndarray, g_left: float, ends: str = "cell")
 
 
 def continuum_modes(chain, phi: float, n_modes: int, *, ends: str = "cell",
-                    Omega: float = 0.0, Omega_dot: float = 0.0,
-                    vectors: bool = True) -> ChainModes:
+                    Omega: float = 0.0, Omega_dot: float = 0.0, vectors: bool = True,
+                    smearing: str = "impedance", estimate: bool = True,
+                    warn: bool = True) -> ChainModes:
     """The ``n_modes`` lowest quasi-eigenfrequencies of the smeared continuum.
 
     Parameters
     ----------
     chain : Chain
         One unit on every node, identical cells (``chain(..., cells=True)``), free or
-        elastic ends, phases arbitrary (smeared by the mean at φ).
+        elastic ends, phases arbitrary.
     phi : float
         Drive angle, rad.
     n_modes : int
         How many roots (at most n = N m).
     ends : {"cell", "shaft"}
         End condition form (module docstring).
+    smearing : {"impedance", "matrices"}
+        ``"impedance"`` (default): the mean of the units' exact dynamic stiffness on their
+        nodes, d̄(λ) = mean_u d_u(λ); independent of the units' internal coordinates.
+        ``"matrices"``: the mean unit matrices M̄, C̄ (the chapter's smearing); for phased
+        units its result depends on the units' choice of internal coordinates
+        (docs/chain.md). Both are the same for identical phases.
+    estimate : bool
+        Also solve the same chain by transfer matrices (:func:`~femmech.chain.transfer.
+        transfer_modes`, O(N) per root) and return the relative error of each root
+        (``error``, matched by rank).
+    warn : bool
+        Issue a :class:`~femmech.errors.ModelWarning` when a delivered root lies outside
+        the validity range (:func:`validity_problems`; with ``estimate``: when its
+        estimated error exceeds :data:`ERROR_WARN`).
 
     Returns
     -------
     ChainModes
         ``method="continuum"``, ``label`` = mode number j (as the cyclic wave number),
-        vectors: the continuum shapes ``Θ_j(x_i) w`` at the assembled coordinates,
-        normalised with the assembled M(φ) (``vᵀ M v = 1``).
+        ``error`` (with ``estimate``) the relative frequency error f_continuum /
+        f_transfer − 1 per root; vectors: the continuum shapes at the assembled
+        coordinates, normalised with the assembled M(φ) (``vᵀ M v = 1``).
     """
+    if smearing not in SMEARINGS:
+        raise ValueError(f"smearing must be one of {', '.join(SMEARINGS)}, got {smearing!r}")
     c = smear(chain, phi, Omega, Omega_dot)
     n_modes = int(n_modes)
     if not 1 <= n_modes <= chain.n:
         raise ValueError(f"n_modes must be in 1..{chain.n}, got {n_modes}")
     labels, mu = mode_wave_numbers(c.n_cells, c.g_left, c.g_right, n_modes, ends)
-    Mp = c.M.copy()
-    Mp[c.attach, c.attach] += c.node_inertia
-    lam, W = unit_branches(Mp, c.C, c.k * mu**2, c.attach)
-    m = Mp.shape[0]
-    order = np.argsort(lam.reshape(-1), kind="stable")[:n_modes]
-    freq = frequencies(lam.reshape(-1)[order], f"continuum at φ = {phi:.6g} rad")
-    vec = None
-    if vectors:
-        vec = expand(chain, mode_shapes(c.n_cells, mu, c.g_left, ends), W)[:, order]
-        M = chain.sparse_matrices(float(phi))[0]
-        vec = vec / np.sqrt(np.einsum("ik,ik->k", vec, M @ vec))
-    return ChainModes(freq, vec, "continuum",
-                      label=np.repeat(labels, m)[order])
+    where = f"continuum at φ = {phi:.6g} rad"
+    if smearing == "impedance":
+        imp = _impedance(chain, phi, Omega, Omega_dot)
+        lam, wave = _impedance_roots(imp, c.k * mu**2, c.node_inertia)
+        order = np.lexsort((wave, lam))[:n_modes]
+        freq = frequencies(lam[order], where)
+        label = labels[wave[order]]
+        vec = None
+        if vectors:
+            shapes = mode_shapes(c.n_cells, mu[wave[order]], c.g_left, ends)
+            vec = _impedance_vectors(chain, phi, lam[order], shapes, imp, Omega, Omega_dot)
+    else:
+        Mp = c.M.copy()
+        Mp[c.attach, c.attach] += c.node_inertia
+        lam, W = unit_branches(Mp, c.C, c.k * mu**2, c.attach)
+        m = Mp.shape[0]
+        order = np.argsort(lam.reshape(-1), kind="stable")[:n_modes]
+        freq = frequencies(lam.reshape(-1)[order], where)
+        label = np.repeat(labels, m)[order]
+        vec = None
+        if vectors:
+            vec = expand(chain, mode_shapes(c.n_cells, mu, c.g_left, ends), W)[:, order]
+            M = chain.sparse_matrices(float(phi))[0]
+            vec = vec / np.sqrt(np.einsum("ik,ik->k", vec, M @ vec))
+    error = _estimate(chain, phi, freq, Omega) if estimate else None
+    if warn:
+        _warn(chain, phi, freq, label, error, c, ends)
+    return ChainModes(freq, vec, "continuum", label=label, error=error)
+
+
+def _estimate(chain, phi, freq, Omega) -> np.ndarray:
+    """Relative error of the continuum's roots against the transfer-matrix roots of the
+    same chain (the k-th lowest against the k-th lowest)."""
+    from femmech.chain.transfer import transfer_modes
+
+    ref = transfer_modes(chain, phi, n_modes=freq.size, vectors=False, Omega=Omega).freq_hz
+    tiny = 1e-9 * max(float(np.abs(ref).max(initial=0.0)), 1e-300)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        err = np.where(np.abs(ref) > tiny, freq / ref - 1,
+                       np.where(np.abs(freq) > tiny, np.inf, 0.0))
+    return err
+
+
+def validity_problems(chain, phi: float, modes: ChainModes, ends: str = "cell") -> list:
+    """Why roots of a continuum solution lie outside the continuum's validity range.
+
+    Conditions (measured in docs/chain.md): (1) long waves, wave number μ_j ≤
+    :data:`MU_VALID` rad per cell (dispersion error ≲ μ²/24 ≈ 1 %); (2) for phased units
+    (phases not all equal), frequencies up to :data:`FREQ_VALID` times the lowest
+    internal frequency √μ_min / 2π of the units (the follower frequency): near and
+    above it the smeared model cannot resolve the units' individual couplings.
+
+    Returns
+    -------
+    list of str
+        One line per violated condition (empty: all roots inside).
+    """
+    c = smear(chain, phi)
+    out = []
+    labels, mu = mode_wave_numbers(c.n_cells, c.g_left, c.g_right, c.n_cells, ends)
+    mu_of = dict(zip(labels.tolist(), mu.tolist(), strict=True))
+    mu_root = np.array([mu_of.get(int(j), np.nan) for j in modes.label])
+    long = np.flatnonzero(mu_root > MU_VALID)
+    if long.size:
+        i = int(long[0])
+        out.append(f"{long.size} root(s) have wave numbers μ > {MU_VALID:g} rad per cell"
+                   f" (first: f = {modes.freq_hz[i]:.6g} Hz, mode {int(modes.label[i])},"
+                   f" μ = {mu_root[i]:.3g}: dispersion ≈ {100 * mu_root[i] ** 2 / 24:.2g} %)")
+    if np.ptp(chain.phase) > 0:
+        imp = _impedance(chain, phi, 0.0, 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            static = imp.caa - np.where(imp.alpha == 0, 0.0, imp.alpha**2 / imp.mu).sum(axis=1)
+        spread = float(np.std(static))
+        lowest_pole = imp.poles[0] if imp.poles.size else np.inf
+        lam = np.sign(modes.freq_hz) * (2 * np.pi * modes.freq_hz) ** 2
+        weak = np.flatnonzero((c.k * np.nan_to_num(mu_root) ** 2 * SPREAD_VALID < spread)
+                              & (lam < lowest_pole))
+        if weak.size:
+            i = int(weak[0])
+            out.append(f"{weak.size} root(s) of phased units whose static stiffness d_u(0)"
+                       f" varies (std {spread:.3g} N m/rad) by more than {SPREAD_VALID:g} ×"
+                       f" the shaft stiffness k μ² of their wave (first: f ="
+                       f" {modes.freq_hz[i]:.6g} Hz, k μ² = {c.k * mu_root[i] ** 2:.3g}"
+                       " N m/rad)")
+        internal = imp.mu[imp.mu > 0]
+        if internal.size:
+            f_int = np.sqrt(internal.min()) / (2 * np.pi)
+            high = np.flatnonzero(modes.freq_hz > FREQ_VALID * f_int)
+            if high.size:
+                out.append(f"{high.size} root(s) of phased units lie above {FREQ_VALID:g} ×"
+                           f" the units' lowest internal frequency {f_int:.6g} Hz (first:"
+                           f" {modes.freq_hz[high[0]]:.6g} Hz)")
+    return out
+
+
+def _warn(chain, phi, freq, label, error, c, ends) -> None:
+    """The ModelWarning of :func:`continuum_modes` (see there)."""
+    import warnings
+
+    from femmech.errors import ModelWarning
+
+    problems = validity_problems(chain, phi, ChainModes(freq, None, "continuum", label=label),
+                                 ends)
+    if error is not None:
+        worst = float(np.max(np.abs(error), initial=0.0))
+        if worst <= ERROR_WARN:
+            return
+        problems.append(f"estimated error up to {100 * worst:.3g} % (transfer-matrix roots"
+                        " of the same chain: ChainModes.error)")
+    if problems:
+        warnings.warn(f"continuum at φ = {float(phi):.6g} rad outside its validity range: "
+                      + "; ".join(problems) + "; use transfer_modes or assembled_modes there",
+                      ModelWarning, stacklevel=3)
 
 
 @dataclass(frozen=True)
@@ -316,8 +473,8 @@ def continuum_error_table(unit, n_values=(5, 10, 20, 40, 100), modes=(1, 2, 3, 5
         ch = chain(unit, int(N), spacing, shaft_diameter, cells=True, left=left,
                    right=right, station_inertia=station_inertia)
         f_d[i] = _by_label(cyclic_modes(ch, phi, vectors=False), modes, m)
-        f_c[i] = _by_label(continuum_modes(ch, phi, ch.n, ends=ends, vectors=False),
-                           modes, m)
+        f_c[i] = _by_label(continuum_modes(ch, phi, ch.n, ends=ends, vectors=False,
+                                           estimate=False, warn=False), modes, m)
         c = smear(ch, phi)
         labels, mu_all = mode_wave_numbers(c.n_cells, c.g_left, c.g_right, c.n_cells, ends)
         for b, j in enumerate(modes):

@@ -22,10 +22,11 @@ Stage 6 (chain): imports mechanisms (for the unit protocol only), nothing above.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
+import sympy
 
 STEEL_G = 80.77e9
 """Shear modulus of steel, Pa (E = 210 GPa, ν = 0.3: G = E / 2(1 + ν))."""
@@ -84,6 +85,22 @@ class End:
 class Chain:
     """A torsional shaft of ``n_nodes`` nodes carrying ``n_units`` identical mechanisms.
 
+    The general constructor: any node inertias, segment stiffnesses, ground springs and
+    clamps (:func:`chain` builds the common uniform shaft from its diameter). Node i has
+    the rotation θ_i (rad), rotary inertia ``node_inertia[i]`` (kg m²: discs, lumped
+    shaft; 0 for a massless node) and a spring ``ground[i]`` (N m/rad) to ground;
+    segment i joins nodes i and i + 1 with the torsional stiffness ``spring[i]``
+    (N m/rad, > 0). Unit u sits on node ``unit_node[u]`` and runs at φ + ``phase[u]``.
+    ``left`` and ``right`` (:class:`End`) add an end condition to node 0 and node
+    n_nodes − 1: their inertia to ``node_inertia``, their stiffness to ``ground``,
+    their clamp to ``clamped``. They are applied once, here, and stored as None, so
+    ``dataclasses.replace`` of a chain does not apply them twice.
+
+    Example: three nodes, a flywheel and a coupling at the left, units on nodes 1 and 2::
+
+        Chain(unit, node_inertia=[0.0, 2e-3, 2e-3], spring=[5e3, 8e4],
+              unit_node=[1, 2], phase=[0.0, np.pi], left=End.elastic(2e4, 0.8))
+
     Attributes
     ----------
     unit : object
@@ -91,21 +108,24 @@ class Chain:
         ``unit.B(phi, Omega)`` and ``unit.C(phi, Omega, Omega_dot)`` (S + (m, m)) for
         ``phi`` of any shape S, rad (a :class:`~femmech.mechanisms.RheolinearModel`).
     node_inertia : ndarray (n_nodes,)
-        Rotary inertia of each node (discs, lumped shaft, end inertias), kg m².
+        Rotary inertia of each node (discs, lumped shaft, end inertias), kg m², >= 0.
     spring : ndarray (n_nodes - 1,)
-        Torsional stiffness of the shaft segment between node i and i + 1, N m/rad.
+        Torsional stiffness of the shaft segment between node i and i + 1, N m/rad, > 0.
     unit_node : ndarray (n_units,) of int
         Node carrying each unit (distinct nodes).
-    phase : ndarray (n_units,)
+    phase : ndarray (n_units,) or float
         Phase angle δ_u of each unit, rad: unit u sees the drive angle φ + δ_u.
-    ground : ndarray (n_nodes,)
-        Torsional spring from each node to ground, N m/rad (elastic ends).
-    clamped : ndarray (n_nodes,) of bool
-        Nodes whose rotation is fixed (removed from the coordinates).
+    ground : ndarray (n_nodes,), optional
+        Torsional spring from each node to ground, N m/rad (elastic ends); default 0.
+    clamped : ndarray (n_nodes,) of bool, optional
+        Nodes whose rotation is fixed (removed from the coordinates); default none.
     attach : int
         Index of the unit coordinate that is the rotation of its node.
-    x : ndarray (n_nodes,)
-        Axial position of each node, m (plots only).
+    x : ndarray (n_nodes,), optional
+        Axial position of each node, m (plots only); default 0, 1, 2, ...
+    left, right : End, optional
+        End conditions added to the first and last node (see above); None after
+        construction.
     """
 
     unit: object
@@ -117,6 +137,8 @@ class Chain:
     clamped: np.ndarray = None
     attach: int = 0
     x: np.ndarray = None
+    left: End | None = None
+    right: End | None = None
     _index: tuple = field(init=False, repr=False)
     _shaft_matrices: tuple = field(init=False, repr=False)
 
@@ -147,13 +169,14 @@ class Chain:
             if value.shape != (n_nodes,):
                 raise ValueError(f"{name} must have n_nodes = {n_nodes} entries,"
                                  f" got {value.shape}")
+        J, ground, clamped = _apply_ends(J, ground, clamped, self.left, self.right)
         m = int(getattr(self.unit, "n", 0))
         if m < 1 or not 0 <= self.attach < m:
             raise ValueError(f"attach must index a unit coordinate (0..{m - 1}),"
                              f" got {self.attach}")
         for name, value in (("node_inertia", J), ("spring", k), ("unit_node", nodes),
                             ("phase", np.array(phase, dtype=float)), ("ground", ground),
-                            ("clamped", clamped), ("x", x)):
+                            ("clamped", clamped), ("x", x), ("left", None), ("right", None)):
             object.__setattr__(self, name, value)
         object.__setattr__(self, "_index", _dof_index(self))
         object.__setattr__(self, "_shaft_matrices", self._shaft())
@@ -280,6 +303,22 @@ class Chain:
         return sp.coo_matrix((blocks[keep], (r[keep], c[keep])), shape=(self.n, self.n))
 
 
+def _apply_ends(J, ground, clamped, left, right):
+    """Node inertias, ground springs and clamps with the End conditions ``left`` (node 0)
+    and ``right`` (last node) added (copies)."""
+    J, ground, clamped = J.copy(), ground.copy(), clamped.copy()
+    for name, end, node in (("left", left, 0), ("right", right, -1)):
+        if end is None:
+            continue
+        if not isinstance(end, End):
+            raise ValueError(f"Chain {name} must be an End (End.free(), End.fixed(),"
+                             f" End.elastic(k, J), End.flywheel(J)), got {end!r}")
+        J[node] += end.inertia
+        ground[node] += end.stiffness
+        clamped[node] |= end.clamped
+    return J, ground, clamped
+
+
 def _dof_index(chain: Chain):
     """Coordinate numbering node by node: (node_dof, unit_dofs, n)."""
     m = chain.m
@@ -329,10 +368,11 @@ def torsion_segment(length: float, diameter: float, bore: float = 0.0, G: float 
     return G * Ip / length, rho * Ip * length
 
 
-def chain(unit, n_units: int, spacing: float, shaft_diameter: float, *,
+def chain(unit, n_units: int, spacing: float, shaft_diameter: float | None = None, *,
           station_inertia: float = 0.0, phases=0.0, left: End = End(), right: End = End(),
           end_length: float | None = None, cells: bool = False, bore: float = 0.0,
-          G: float = STEEL_G, rho: float = STEEL_RHO, attach: int = 0) -> Chain:
+          G: float = STEEL_G, rho: float = STEEL_RHO, attach: int = 0,
+          shaft_stiffness: float | None = None, shaft_inertia: float | None = None) -> Chain:
     """A uniform main shaft with ``n_units`` equally spaced identical mechanisms.
 
     Nodes: one per unit, ``spacing`` (m) apart; with ``end_length`` (m) a further node at
@@ -343,6 +383,13 @@ def chain(unit, n_units: int, spacing: float, shaft_diameter: float, *,
     every unit node carries exactly one spacing of shaft inertia: the chain is then a row
     of identical cells (what the cyclic closed form and the continuum assume).
 
+    The shaft per spacing has the stiffness c_s = G I_p / spacing and the inertia
+    J_s = ρ I_p spacing (:func:`torsion_segment`) unless given exactly:
+    ``shaft_stiffness`` = c_s (N m/rad) and ``shaft_inertia`` = J_s (kg m², 0 for a
+    massless shaft) replace the values from the diameter; an end stub of length L then
+    has c_s · spacing / L and J_s · L / spacing. With both given, ``shaft_diameter`` may
+    be None.
+
     Parameters
     ----------
     unit : object
@@ -351,8 +398,9 @@ def chain(unit, n_units: int, spacing: float, shaft_diameter: float, *,
     n_units : int
     spacing : float
         Distance between neighbouring units, m.
-    shaft_diameter : float
-        Outer diameter, m (``bore``: inner diameter, m).
+    shaft_diameter : float, optional
+        Outer diameter, m (``bore``: inner diameter, m); needed unless both
+        ``shaft_stiffness`` and ``shaft_inertia`` are given.
     end_length : float, optional
         Length of an end stub, m (adds an end node at each end).
     cells : bool
@@ -365,6 +413,10 @@ def chain(unit, n_units: int, spacing: float, shaft_diameter: float, *,
         End conditions (applied at the end nodes).
     G, rho : float
         Shear modulus (Pa) and density (kg/m³) of the shaft.
+    shaft_stiffness : float, optional
+        Exact torsional stiffness of one spacing of shaft, N m/rad (> 0).
+    shaft_inertia : float, optional
+        Exact rotary inertia of one spacing of shaft, kg m² (>= 0; 0: massless shaft).
 
     Returns
     -------
@@ -373,59 +425,88 @@ def chain(unit, n_units: int, spacing: float, shaft_diameter: float, *,
     if int(n_units) != n_units or n_units < 1:
         raise ValueError(f"n_units must be a positive integer, got {n_units!r}")
     n_units = int(n_units)
-    Jseg = torsion_segment(spacing, shaft_diameter, bore, G, rho)[1]
+    if not (np.isfinite(spacing) and spacing > 0):
+        raise ValueError(f"spacing must be finite and > 0, got {spacing!r}")
+    k_s, J_s = _shaft_per_spacing(spacing, shaft_diameter, bore, G, rho, shaft_stiffness,
+                                  shaft_inertia)
     lengths = [spacing] * (n_units - 1)
     if end_length is not None:
+        if not (np.isfinite(end_length) and end_length > 0):
+            raise ValueError(f"end_length must be finite and > 0, got {end_length!r}")
         lengths = [end_length] + lengths + [end_length]
-    segments = [torsion_segment(L, shaft_diameter, bore, G, rho) for L in lengths]
+    ratio = np.asarray(lengths, dtype=float) / spacing
+    spring, Jseg = k_s / ratio, J_s * ratio
     n_nodes = len(lengths) + 1
     J = np.zeros(n_nodes)
-    spring = np.array([s[0] for s in segments])
-    for i, (_, Js) in enumerate(segments):
-        J[i] += Js / 2
-        J[i + 1] += Js / 2
+    J[:-1] += Jseg / 2
+    J[1:] += Jseg / 2
     first = 0 if end_length is None else 1
     unit_node = np.arange(first, first + n_units)
     if cells:  # the half spacing beyond each outer unit
-        J[unit_node[0]] += Jseg / 2
-        J[unit_node[-1]] += Jseg / 2
+        J[unit_node[0]] += J_s / 2
+        J[unit_node[-1]] += J_s / 2
     J[unit_node] += station_inertia
-    J[0] += left.inertia
-    J[-1] += right.inertia
-    ground = np.zeros(n_nodes)
-    ground[0] += left.stiffness
-    ground[-1] += right.stiffness
-    clamped = np.zeros(n_nodes, bool)
-    clamped[0] |= left.clamped
-    clamped[-1] |= right.clamped
     x = np.concatenate([[0.0], np.cumsum(lengths)])
     return Chain(unit, J, spring, unit_node, np.broadcast_to(np.asarray(phases, float),
-                 (n_units,)).copy(), ground, clamped, attach, x)
+                 (n_units,)).copy(), None, None, attach, x, left=left, right=right)
+
+
+def _shaft_per_spacing(spacing, diameter, bore, G, rho, stiffness, inertia):
+    """(c_s N m/rad, J_s kg m²) of one spacing of shaft: the exact values where given,
+    else from the diameter (:func:`torsion_segment`)."""
+    if stiffness is not None and not (np.isfinite(stiffness) and stiffness > 0):
+        raise ValueError(f"shaft_stiffness must be finite and > 0 N m/rad, got {stiffness!r}")
+    if inertia is not None and not (np.isfinite(inertia) and inertia >= 0):
+        raise ValueError(f"shaft_inertia must be finite and >= 0 kg m², got {inertia!r}")
+    if stiffness is not None and inertia is not None:
+        return float(stiffness), float(inertia)
+    if diameter is None:
+        raise ValueError("give shaft_diameter, or both shaft_stiffness and shaft_inertia")
+    k, J = torsion_segment(spacing, diameter, bore, G, rho)
+    return (k if stiffness is None else float(stiffness)), (J if inertia is None
+                                                            else float(inertia))
 
 
 def follower_unit(cam, inertia: float, mass: float, stiffness: float, damping: float = 0.0,
-                  force: float = 0.0):
+                  force: float = 0.0, c_g: float = 0.0):
     """The standard unit: Table 5.1 case 1 without its shaft spring (the chain is the shaft).
 
     A cam (or linkage) ``cam`` (position function U(ψ), m, of the shaft angle ψ, rad) on
     its node (rotary inertia ``inertia``, kg m², of the cam hub about the shaft) moves a
     follower mass ``mass`` (kg) through its elastic follower train ``stiffness`` (N/m;
-    ``damping`` N s/m) against a process force ``force`` (N). Coordinates (q1, q2): q1 the
-    shaft rotation at the node (rad, ``attach = 0``), q2 the follower's elastic deflection
-    (m). Frozen (Ω = 0): ``M = [[J + m U'², m U'], [m U', m]]``, ``C = diag(F U'', c)``.
+    ``damping`` N s/m) against a process force ``force`` (N). ``c_g`` (N/m) is a spring
+    from the follower to ground (the frame: a return spring), acting on the follower's
+    absolute position x2 = U(ψ) + q2 and unstressed at x2 = 0 (potential ½ c_g x2²).
+    Coordinates (q1, q2): q1 the shaft rotation at the node (rad, ``attach = 0``), q2 the
+    follower's elastic deflection relative to the cam motion (m). Frozen (Ω = 0)::
+
+        M = [[J + m U'², m U'], [m U', m]]
+        C = [[F U'' + c_g (U'² + U U''), c_g U'], [c_g U', c + c_g]]
+
+    (c_g couples q1 and q2 through U': the unit's internal coordinate is relative to
+    the cam motion; see the continuum's validity conditions in docs/chain.md).
 
     Returns
     -------
     RheolinearModel
     """
-    from femmech.mechanisms import rheolinear, table_5_1_case
+    from femmech.mechanisms import Spring, rheolinear, table_5_1_case
 
     for name, value in (("inertia", inertia), ("mass", mass), ("stiffness", stiffness),
-                        ("damping", damping)):
+                        ("damping", damping), ("c_g", c_g)):
         if not (np.isfinite(value) and value >= 0):
-            raise ValueError(f"{name} must be finite and >= 0, got {value!r}")
+            raise ValueError(f"follower_unit: {name} must be finite and >= 0, got {value!r}")
+    if not np.isfinite(force):
+        raise ValueError(f"follower_unit: force must be finite, got {force!r}")
     if not mass > 0 or not stiffness > 0:
-        raise ValueError(f"mass and stiffness must be > 0, got {mass!r}, {stiffness!r}")
+        raise ValueError(f"follower_unit: mass and stiffness must be > 0, got {mass!r},"
+                         f" {stiffness!r}")
     values = {"J1": inertia, "m2": mass, "c1": 0.0, "c2": stiffness, "b1": 0.0,
               "b2": damping, "F2": force}
-    return rheolinear(table_5_1_case(1), values, {"U": cam})
+    mech = table_5_1_case(1)
+    if c_g > 0:
+        x2 = next(e.position[0] for e in mech.elements if type(e).__name__ == "PointMass")
+        cg = sympy.Symbol("cg", positive=True)
+        mech = replace(mech, elements=mech.elements + (Spring(cg, x2),))
+        values["cg"] = c_g
+    return rheolinear(mech, values, {"U": cam})

@@ -32,7 +32,11 @@ class ChainModes:
         Wittrick–Williams count of eigenvalues strictly below each root (transfer),
         else None.
     converged : ndarray (k,) of bool
-        The root's bracket met its tolerance.
+        The root's bracket met its tolerance (and its checks, transfer).
+    error : ndarray (k,) or None
+        Estimated relative frequency error of each root where the method is an
+        approximation (continuum: against the transfer-matrix roots of the same chain),
+        else None.
     """
 
     freq_hz: np.ndarray
@@ -41,6 +45,7 @@ class ChainModes:
     label: np.ndarray | None = None
     count: np.ndarray | None = None
     converged: np.ndarray | None = None
+    error: np.ndarray | None = None
 
     def __post_init__(self):
         freq = np.asarray(self.freq_hz, dtype=float).reshape(-1)
@@ -52,7 +57,9 @@ class ChainModes:
             value = getattr(self, name)
             if value is not None:
                 object.__setattr__(self, name, np.asarray(value, dtype=int).reshape(-1))
-        for name in ("label", "count", "converged"):
+        if self.error is not None:
+            object.__setattr__(self, "error", np.asarray(self.error, dtype=float).reshape(-1))
+        for name in ("label", "count", "converged", "error"):
             value = getattr(self, name)
             if value is not None and value.size != freq.size:
                 raise ValueError(f"ChainModes.{name} has {value.size} entries,"

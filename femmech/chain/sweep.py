@@ -41,7 +41,12 @@ def chain_sweep(chain, phi, n_modes: int, method: str = "transfer",
     phi : array_like (n_angles,)
         Drive angles, rad, in sweep order (e.g. ``np.linspace(0, 2π, 181)``).
     n_modes : int
-        Number of branches (the n lowest at the first angle).
+        The n lowest roots at *every* angle, in n columns: a branch keeps its column
+        while it is among the n lowest; when one leaves and another (from above) enters,
+        the column passes to the entering branch and ``mac_step`` is 0 there. Tracking
+        follows more branches than n (MAC: the sweep is repeated with twice as many
+        where a root below the n-th lowest was not among them), so no root among the n
+        lowest is missed at any angle.
     method : str
         One of :data:`METHODS`.
     frequency_weight : float
@@ -54,7 +59,8 @@ def chain_sweep(chain, phi, n_modes: int, method: str = "transfer",
     Sweep
         ``form="symmetric"``; ``freq_hz`` = Re √λ / 2π (0 and damping ratio −1 for a
         root λ < 0: divergence); ``mac_step``: MAC (subspace MAC in clusters) of each
-        branch with itself at the previous angle (label tracking: the MAC of the same
+        branch with itself at the previous angle (0 where the column passes to another
+        branch) (label tracking: the MAC of the same
         label's vectors if the method has vectors, else 1); NaN where a label-tracked
         branch is absent at an angle.
     """
@@ -92,7 +98,7 @@ def _modes(chain, phi, count, method, vectors=True) -> ChainModes:
         return cyclic_modes(chain, phi, vectors=vectors)
     from femmech.chain.continuum import continuum_modes
 
-    return continuum_modes(chain, phi, count, vectors=vectors)
+    return continuum_modes(chain, phi, count, vectors=vectors, estimate=False, warn=False)
 
 
 def _lambda_columns(freq_hz):
@@ -103,18 +109,68 @@ def _lambda_columns(freq_hz):
 
 
 def _mac_sweep(chain, phi, n_modes, method, weight, keep_vectors) -> Sweep:
+    """MAC-tracked sweep of every branch that is among the ``n_modes`` lowest at some
+    angle: more branches are tracked than asked for, and the sweep is repeated with
+    twice as many wherever a root among the n lowest was not one of them."""
+    tracked = min(n_modes + max(2, n_modes // 2), chain.n)
+    while True:
+        out = _track(chain, phi, n_modes, tracked, method, weight, keep_vectors)
+        if out is not None or tracked == chain.n:
+            break
+        tracked = min(2 * tracked, chain.n)
+    return _lowest_columns(phi, *out, n_modes)
+
+
+def _lowest_columns(phi, lam, freq, ratio, mac_step, vectors, low, n_modes) -> Sweep:
+    """The Sweep of the ``n_modes`` lowest roots at every angle from tracked branches
+    (n_angles, b) with ``low`` True where a branch is among the n lowest: a branch keeps
+    its column while it stays among them; a column whose branch leaves passes to a branch
+    that enters (lowest first), with ``mac_step`` 0 at that angle."""
+    n_angles = phi.size
+    cols = np.full((n_angles, n_modes), -1)
+    order = np.argsort(np.where(low[0], np.nan_to_num(freq[0], nan=np.inf), np.inf),
+                       kind="stable")
+    cols[0] = order[:n_modes]
+    switched = np.zeros((n_angles, n_modes), bool)
+    for a in range(1, n_angles):
+        here = np.flatnonzero(low[a])
+        here = here[np.argsort(np.nan_to_num(freq[a, here], nan=np.inf), kind="stable")]
+        here = here[:n_modes]
+        stay = np.isin(cols[a - 1], here)
+        cols[a] = np.where(stay, cols[a - 1], -1)
+        entering = [b for b in here if b not in cols[a]]
+        free = np.flatnonzero(cols[a] < 0)
+        for c, b in zip(free, entering, strict=False):
+            cols[a, c] = b
+            switched[a, c] = True
+        cols[a, cols[a] < 0] = cols[a - 1, cols[a] < 0]  # (fewer than n roots: keep)
+    rows = np.arange(n_angles)[:, None]
+    macs = np.where(switched, 0.0, mac_step[rows, cols])
+    vec = None if vectors is None else np.take_along_axis(vectors, cols[:, None, :], axis=2)
+    return Sweep(phi, freq[rows, cols], lam[rows, cols], ratio[rows, cols], vec, macs,
+                 "symmetric")
+
+
+def _track(chain, phi, n_modes, tracked, method, weight, keep_vectors):
+    """Follow ``tracked`` branches (the lowest at the first angle) over ``phi``.
+
+    Returns ``(lam, freq, ratio, mac_step, vectors, low)`` (n_angles, tracked) arrays
+    (vectors (n_angles, n, tracked) or None) with ``low`` True where the branch is among
+    the ``n_modes`` lowest roots at that angle; None if at some angle a root below the
+    n-th lowest is not on a tracked branch (more branches must be tracked)."""
     n_angles, n = phi.size, chain.n
-    lam = np.zeros((n_angles, n_modes), dtype=complex)
-    freq, ratio = np.zeros((n_angles, n_modes)), np.zeros((n_angles, n_modes))
-    mac_step = np.ones((n_angles, n_modes))
-    vectors = np.zeros((n_angles, n, n_modes)) if keep_vectors else None
-    extra = min(n_modes + max(2, n_modes // 2), n)
+    lam = np.zeros((n_angles, tracked), dtype=complex)
+    freq, ratio = np.zeros((n_angles, tracked)), np.zeros((n_angles, tracked))
+    mac_step = np.ones((n_angles, tracked))
+    low = np.zeros((n_angles, tracked), bool)
+    vectors = np.zeros((n_angles, n, tracked)) if keep_vectors else None
+    extra = min(tracked + max(2, tracked // 2), n)
     previous = None
     for a, angle in enumerate(phi):
         modes = _modes(chain, angle, extra, method)
         f = modes.freq_hz
         groups = clusters(f)
-        while f.size == extra < n and cuts_cluster(groups, f.size, n_modes):
+        while f.size == extra < n and cuts_cluster(groups, f.size, tracked):
             extra = min(2 * extra, n)  # complete the cluster (kept for later angles)
             modes = _modes(chain, angle, extra, method)
             f = modes.freq_hz
@@ -122,17 +178,22 @@ def _mac_sweep(chain, phi, n_modes, method, weight, keep_vectors) -> Sweep:
         M = chain.sparse_matrices(angle)[0]
         V = _canonical_repeated(modes.vectors, f, M)  # solver-independent before assigning
         if previous is None:
-            pick, macs = np.arange(n_modes), np.ones(n_modes)
+            pick, macs = np.arange(tracked), np.ones(tracked)
         else:
             pick, macs = assign_branches(previous, V, f, groups, M, weight)
-        if previous is not None:
             V = _align_repeated(V, f, pick, previous[0], M)
+        top = f[min(n_modes, f.size) - 1]
+        tol = REPEATED_RTOL * max(abs(top), 1e-300)
+        below = np.flatnonzero(f < top - tol)
+        if not np.isin(below, pick).all():
+            return None  # a branch from above the tracked ones entered the n lowest
+        low[a] = f[pick] <= top + tol
         lam[a], freq[a], ratio[a] = _lambda_columns(f[pick])
         mac_step[a] = macs
         previous = (V[:, pick], f[pick])
         if keep_vectors:
             vectors[a] = previous[0]
-    return Sweep(phi, freq, lam, ratio, vectors, mac_step, "symmetric")
+    return lam, freq, ratio, mac_step, vectors, low
 
 
 def _align_repeated(V, f, pick, V_prev, M) -> np.ndarray:
@@ -178,23 +239,30 @@ def _exact_groups(f):
 
 def _label_sweep(chain, phi, n_modes, method, keep_vectors) -> Sweep:
     n_angles, n = phi.size, chain.n
-    lam = np.full((n_angles, n_modes), np.nan, dtype=complex)
-    freq = np.full((n_angles, n_modes), np.nan)
-    ratio = np.zeros((n_angles, n_modes))
-    mac_step = np.ones((n_angles, n_modes))
-    vectors = np.full((n_angles, n, n_modes), np.nan) if keep_vectors else None
     count = min(n, 2 * n_modes + 2 * chain.m)
-    keys, previous = None, None
+    keys = []  # every (label, rank) among the n lowest at some angle, first seen first
+    for angle in phi:
+        for key in _keys(_modes(chain, angle, count, method, vectors=False).label)[:n_modes]:
+            if key not in keys:
+                keys.append(key)
+    n_branches = len(keys)
+    low = np.zeros((n_angles, n_branches), bool)
+    lam = np.full((n_angles, n_branches), np.nan, dtype=complex)
+    freq = np.full((n_angles, n_branches), np.nan)
+    ratio = np.zeros((n_angles, n_branches))
+    mac_step = np.ones((n_angles, n_branches))
+    vectors = np.full((n_angles, n, n_branches), np.nan) if keep_vectors else None
+    previous = None
     for a, angle in enumerate(phi):
         modes = _modes(chain, angle, count, method, vectors=True)
         found = _keys(modes.label)
-        if keys is None:
-            keys = found[:n_modes]
         where = {key: i for i, key in enumerate(found)}
         idx = np.array([where.get(key, -1) for key in keys])
         ok = idx >= 0
+        lowest = set(found[:n_modes])
+        low[a] = [key in lowest for key in keys]
         lam[a, ok], freq[a, ok], ratio[a, ok] = _lambda_columns(modes.freq_hz[idx[ok]])
-        V = None if modes.vectors is None else np.full((n, n_modes), np.nan)
+        V = None if modes.vectors is None else np.full((n, n_branches), np.nan)
         if V is not None:
             V[:, ok] = modes.vectors[:, idx[ok]]
             if previous is not None:
@@ -202,7 +270,7 @@ def _label_sweep(chain, phi, n_modes, method, keep_vectors) -> Sweep:
             previous = V
             if keep_vectors:
                 vectors[a] = V
-    return Sweep(phi, freq, lam, ratio, vectors, mac_step, "symmetric")
+    return _lowest_columns(phi, lam, freq, ratio, mac_step, vectors, low, n_modes)
 
 
 def _keys(label) -> list[tuple[int, int]]:

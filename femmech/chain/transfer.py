@@ -40,6 +40,7 @@ Stage 6 (chain): imports solve and analysis (reference solves), numpy and scipy.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,6 +48,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from femmech.chain.results import ChainModes
+from femmech.errors import ConvergenceWarning
 from femmech.solve import threads
 
 SYMMETRY_RTOL = 1e-10
@@ -83,11 +85,35 @@ than 4 brackets: a pass evaluates about 4 × MULTISECTION frequencies at most pe
 group, so few brackets converge in few passes over the N nodes)."""
 
 ZERO_RTOL = 1e-14
-"""Roots with |λ| below this times the largest node/unit eigenvalue ratio are zero
-(rigid-body); the count's round-off near λ = 0 is about 1e-16 of that scale."""
+"""Roots with |λ| below this times the chain's eigenvalue scale (:func:`_eigenvalue_scale`:
+the trace ratio of C and M over the node rotations) are zero (rigid-body); the count's
+round-off near λ = 0 is about 1e-16 of that scale. Roots reported as zero are checked
+(:data:`ZERO_CHECK`)."""
 
-DENSE_MAX = 2000
-"""assembled_modes uses dense LAPACK up to this many coordinates, sparse shift-invert above."""
+DENSE_MAX = 400
+"""``assembled_modes(solver="auto")`` uses dense LAPACK below this many coordinates (and
+for all modes), sparse shift-invert above. Measured, 10 lowest modes of a fixed-free
+phased follower chain (one BLAS thread): n = 199 dense 8.6 ms / sparse 12.7 ms, n = 399
+63 / 57 ms, n = 999 324 / 17 ms, n = 1999 1.7 s / 11.5 ms (150x)."""
+
+SOLVERS = ("auto", "dense", "sparse")
+"""Solvers of :func:`assembled_modes`."""
+
+MASS_RTOL = 1e-12
+"""Directions of a Ritz basis with ``vᵀ M v`` below this times the largest are massless
+(dropped: their eigenvalue is infinite)."""
+
+ZERO_CHECK = 1e-12
+"""A root reported as zero (rigid-body) must have a vector with
+``‖C v‖ <= ZERO_CHECK ‖|C| |v|‖``: C annihilates it up to round-off (a rigid rotation
+computed by inverse iteration gives ~1e-16; a soft but elastic mode gives λ m / k of its
+nodes, 1.4e-10 for the 0.048 Hz root of a follower unit without hub inertia). Roots that
+fail are flagged unconverged."""
+
+STURM_CHECK_MAX = 2000
+"""``transfer_modes(verify=None)`` checks the Wittrick–Williams count against the
+assembled model's Sturm count (an LDLᵀ of C − σM, :func:`femmech.solve.sturm.inertia_below`)
+up to this many coordinates (a few sparse factorisations, ~1 ms each at n = 400)."""
 
 OPERATIONS = {"pivot_steps": 0}
 """Running total of pivot-recurrence steps (node × frequency) of :func:`count_below` and
@@ -136,13 +162,32 @@ def _frozen(chain, phi: float, Omega: float = 0.0) -> _Frozen:
     mu, Phi, alpha, beta = _internal_modes(Mu, Cu, a, inner)
     M, _, C = chain.sparse_matrices(float(phi), Omega)
     J = chain.node_inertia[free]
-    ratios = [np.abs(base[J > 0]) / J[J > 0], np.abs(mu).ravel()]
     maa, caa = Mu[:, a, a], Cu[:, a, a]
-    ratios.append(np.abs(caa[maa > 0]) / maa[maa > 0])
-    scale = max([float(r.max()) for r in ratios if r.size] + [1e-300])
+    scale = _eigenvalue_scale(J, base, maa, caa, free_index[chain.unit_node[on_free]],
+                              np.flatnonzero(on_free), mu)
     return _Frozen(J, base, chain.ground[free], k[:-1][free], k[1:][free], couple,
                    free_index[chain.unit_node[on_free]], np.flatnonzero(on_free), caa, maa,
                    alpha, beta, mu, Phi, np.sort(mu.ravel()), scale, M, C, abs(M), abs(C))
+
+
+def _eigenvalue_scale(J, base, maa, caa, unit_row, unit_free, mu) -> float:
+    """Typical eigenvalue of the frozen chain, rad²/s²: the ratio of the traces of the
+    assembled C and M over the node rotations, ``Σ_i (g_i + k_{i-1} + k_i + |C_aa|) /
+    Σ_i (J_i + M_aa)`` (N m/rad over kg m², the same units on every node, so the units'
+    internal coordinates do not enter).
+
+    A ratio of sums, not the largest ratio of any node or unit: a unit whose M_aa is tiny
+    but not zero (no hub inertia, U' ≈ 0) has C_aa / M_aa of any size (3.5e21 for
+    U' = 6e-13) and would set the rigid-body threshold :data:`ZERO_RTOL` × scale above
+    real roots. A rigid-body root perturbed by round-off δ in the springs moves by
+    Σ δ_i / Σ m_i, so this ratio is also the right measure of where zero ends. Without
+    any node mass, the largest internal eigenvalue (or 1) is taken."""
+    stiff, mass = np.abs(base), J.astype(float).copy()
+    stiff[unit_row] += np.abs(caa[unit_free])
+    mass[unit_row] += np.maximum(maa[unit_free], 0.0)
+    if mass.sum() > 0 and stiff.sum() > 0:
+        return float(stiff.sum() / mass.sum())
+    return float(max(np.abs(mu).max(initial=0.0), 1.0))
 
 
 def _check_symmetric(Cu, Omega) -> None:
@@ -331,7 +376,8 @@ def _search_range(fz, n_modes, f_max, n_total):
 
 
 def transfer_modes(chain, phi: float, n_modes: int | None = None, f_max: float | None = None,
-                   rtol: float = 1e-12, vectors: bool = True, Omega: float = 0.0) -> ChainModes:
+                   rtol: float = 1e-12, vectors: bool = True, Omega: float = 0.0,
+                   verify: bool | None = None) -> ChainModes:
     """Quasi-eigenfrequencies (and modes) of the frozen chain by stabilised transfer
     matrices with the Wittrick–Williams count: no root is missed.
 
@@ -346,20 +392,26 @@ def transfer_modes(chain, phi: float, n_modes: int | None = None, f_max: float |
         All roots below f_max, Hz (with n_modes too: at most n_modes of them).
     rtol : float
         Relative width of the final bracket of each root in λ = ω². Roots with
-        ``|λ| <= ZERO_RTOL`` times the largest node/unit eigenvalue (rigid-body roots,
-        where the count is round-off) stop there.
+        ``|λ| <= ZERO_RTOL`` times the chain's eigenvalue scale (rigid-body roots,
+        where the count is round-off) stop there and are reported as 0 (checked).
     vectors : bool
         Compute the modes (assembled coordinates, M-normalised, M-orthogonal within
         repeated roots).
     Omega : float
         Drive speed, rad/s, in C(φ, Ω) (C must stay symmetric; default 0).
+    verify : bool, optional
+        Check the Wittrick–Williams count against the Sturm count of the assembled model
+        (LDLᵀ of C − σM) below the lowest root, just above the highest and around zero;
+        default: for chains of up to :data:`STURM_CHECK_MAX` coordinates. Roots reported
+        as zero are always checked (C v ≈ 0, :data:`ZERO_CHECK`).
 
     Returns
     -------
     ChainModes
         ``method="transfer"``; ``count`` = J just below each root's bracket (shared by
         the copies of a repeated root); ``converged`` False where the bisection stopped
-        before ``rtol``. Roots λ < 0 (divergence) have negative ``freq_hz`` = −√|λ| / 2π.
+        before ``rtol`` or a check failed (then a ConvergenceWarning says which). Roots
+        λ < 0 (divergence) have negative ``freq_hz`` = −√|λ| / 2π.
     """
     if n_modes is None and f_max is None:
         raise ValueError("give n_modes (the lowest roots) or f_max (all roots below it, Hz)")
@@ -377,9 +429,75 @@ def transfer_modes(chain, phi: float, n_modes: int | None = None, f_max: float |
     if vectors:
         with threads.solve_phase():  # many small dense products: one BLAS thread
             V = _vectors(chain, fz, lam, np.array(roots.j0_jump)[order])
+    conv = np.array(roots.conv, dtype=bool)[order]
+    verify = chain.n <= STURM_CHECK_MAX if verify is None else bool(verify)
+    conv = _verified(fz, lam, conv, V, lo, zero, verify, phi)
     freq = np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)
     return ChainModes(freq, V, "transfer", None, np.array(roots.count, dtype=int)[order],
-                      np.array(roots.conv, dtype=bool)[order])
+                      conv)
+
+
+def _verified(fz: _Frozen, lam, conv, V, lo, zero, sturm, phi) -> np.ndarray:
+    """``conv`` with the roots that fail a check set False (ConvergenceWarning): roots
+    reported as zero need a vector that C annihilates (:data:`ZERO_CHECK`); with
+    ``sturm`` the count J(σ) must equal the assembled Sturm count at σ = ``lo`` (below
+    every root), just above the highest root and at ±``zero``."""
+    conv = conv.copy()
+    problems = []
+    at_zero = np.flatnonzero(lam == 0.0)
+    if at_zero.size:
+        V0 = (V[:, at_zero] if V is not None else _Banded(
+            fz.M, fz.C, fz.abs_m, fz.abs_c).block_inverse_iteration(lam[at_zero], fz.scale))
+        ratio = (np.linalg.norm(fz.C @ V0, axis=0)
+                 / np.maximum(np.linalg.norm(fz.abs_c @ np.abs(V0), axis=0), 1e-300))
+        if ratio.max() > ZERO_CHECK:
+            conv[at_zero] = False
+            problems.append(f"{at_zero.size} root(s) reported as 0 are not rigid-body"
+                            f" (‖C v‖ / ‖|C| |v|‖ = {ratio.max():.2g} > {ZERO_CHECK:g})")
+    if sturm and lam.size:
+        top = float(lam[-1]) + max(1e-6 * abs(float(lam[-1])), 2.0 * zero)
+        cuts = np.unique([lo, top] + ([-zero, zero] if at_zero.size else []))
+        bad = _count_mismatch(fz, cuts)
+        if bad:  # a root within round-off of a cut: both counts are right; move the cut
+            bad = [b for b in bad if all(_count_mismatch(fz, np.array([b[0] + shift])) for
+                                         shift in (-3e-7 * abs(b[0]) - zero,
+                                                   3e-7 * abs(b[0]) + zero))]
+        if bad:
+            conv[:] = False
+            c, a, b = bad[0]
+            problems.append(f"the count below λ = {c:.6g} rad²/s² is {a}, the assembled"
+                            f" model's Sturm count {b}")
+    if problems:
+        warnings.warn(f"transfer_modes at φ = {float(phi):.6g} rad: roots not verified: "
+                      + "; ".join(problems) + " (flagged converged=False)",
+                      ConvergenceWarning, stacklevel=3)
+    return conv
+
+
+def _count_mismatch(fz: _Frozen, cuts) -> list:
+    """(cut, J(cut), assembled Sturm count) where the two differ (no Sturm count: no
+    mismatch)."""
+    mine = _count(fz, cuts)
+    theirs = _sturm_counts(fz.M, fz.C, cuts)
+    return [(c, a, b) for c, a, b in zip(cuts, mine, theirs, strict=True)
+            if b is not None and a != b]
+
+
+def _sturm_counts(M, C, cuts) -> list:
+    """Eigenvalues of the assembled C v = λ M v below each cut (Sylvester's law of inertia
+    of C − σM: sparse LDLᵀ, or dense eigenvalues of C − σM up to 400 coordinates where
+    the sparse factorisation pivoted off the diagonal); None where neither applies."""
+    from femmech.solve.sturm import inertia_below
+
+    Cc, Mc = C.tocsc(), M.tocsc()
+    out = []
+    for cut in cuts:
+        count = inertia_below(Cc, Mc, float(cut))
+        if count is None and C.shape[0] <= 400:
+            A = (C - float(cut) * M).toarray()
+            count = int(np.count_nonzero(np.linalg.eigvalsh(0.5 * (A + A.T)) < 0))
+        out.append(count)
+    return out
 
 
 def _vectors(chain, fz: _Frozen, lam: np.ndarray, j0_jump: np.ndarray) -> np.ndarray:
@@ -414,10 +532,26 @@ def _split_at_gaps(g, lam, size: int) -> list:
 
 def _rayleigh_ritz(X, M, C) -> np.ndarray:
     """Ritz vectors (M-normalised, ascending) of C v = λ M v in span(X)."""
-    X = np.linalg.qr(X)[0]
-    Cp, Mp = X.T @ (C @ X), X.T @ (M @ X)
-    _, Y = sla.eigh(0.5 * (Cp + Cp.T), 0.5 * (Mp + Mp.T))
-    return _normalise(X @ Y, M)
+    return _normalise(_ritz(np.linalg.qr(X)[0], M, C)[1], M)
+
+
+def _ritz(X, M, C):
+    """Ritz pairs ``(θ (b',), Y (n, b'))`` of C v = λ M v in span(X) (X (n, b)
+    orthonormal), M-orthonormal, ascending. Directions of span(X) without mass (massless
+    coordinates: infinite eigenvalues; M may be singular) are condensed statically
+    within the span (their infinite Ritz values dropped), so b' <= b."""
+    Mp, Cp = X.T @ (M @ X), X.T @ (C @ X)
+    Mp, Cp = 0.5 * (Mp + Mp.T), 0.5 * (Cp + Cp.T)
+    w, Q = np.linalg.eigh(Mp)
+    keep = w > MASS_RTOL * max(float(w.max(initial=0.0)), 1e-300)
+    if keep.all():  # the usual case: Cholesky of Mp, as accurate as it gets
+        theta, Y = sla.eigh(Cp, Mp)
+        return theta, X @ Y
+    B, N = Q[:, keep] / np.sqrt(w[keep]), Q[:, ~keep]
+    Cnn, Cnb = N.T @ Cp @ N, N.T @ Cp @ B
+    B = B - N @ np.linalg.lstsq(Cnn, Cnb, rcond=None)[0]  # massless part follows statically
+    theta, Y = sla.eigh(B.T @ Cp @ B, B.T @ Mp @ B)
+    return theta, X @ (B @ Y)
 
 
 def _groups(lam, rtol, scale):
@@ -540,10 +674,8 @@ class _Banded:
         X = np.random.default_rng(12345).standard_normal((self.n, b))
         for _ in range(max_steps):
             X = np.linalg.qr(solve(self.M @ X))[0]  # steps amplify the cluster ~1e12
-            Cp, Mp = X.T @ (self.C @ X), X.T @ (self.M @ X)
-            theta, Y = sla.eigh(0.5 * (Cp + Cp.T), 0.5 * (Mp + Mp.T))
+            theta, X = _ritz(X, self.M, self.C)
             pick = np.sort(np.argsort(np.abs(theta - sigma), kind="stable")[:k])
-            X = X @ Y
             if np.all(_residual_ratio(self.M, self.C, X[:, pick], theta[pick], self.abs_m,
                                       self.abs_c) <= 1.0):
                 break
@@ -569,13 +701,16 @@ class _Banded:
 
 
 def assembled_modes(chain, phi: float, n_modes: int | None = None,
-                    f_max: float | None = None, Omega: float = 0.0) -> ChainModes:
+                    f_max: float | None = None, Omega: float = 0.0,
+                    solver: str = "auto") -> ChainModes:
     """Reference: quasi-modes of the assembled chain ``C(φ, Ω) v = λ M(φ) v``.
 
-    Dense LAPACK (``scipy.linalg.eigh``) for ``chain.n <= DENSE_MAX`` coordinates, else
-    sparse shift-invert Lanczos with a Sturm check
-    (:func:`femmech.solve.eigen.solve_symmetric`). An unsymmetric C (Ω ≠ 0 with U'''
-    terms) is solved densely by QZ (:func:`femmech.analysis.sweep.frozen_modes`):
+    ``solver="dense"``: LAPACK ``scipy.linalg.eigh`` of the dense matrices (every mode;
+    M must be positive definite); ``"sparse"``: shift-invert Lanczos with a Sturm check
+    (:func:`femmech.solve.eigen.solve_symmetric`; n_modes or f_max needed; massless
+    coordinates allowed); ``"auto"`` (default): dense below :data:`DENSE_MAX`
+    coordinates or when every mode is asked for, else sparse. An unsymmetric C (Ω ≠ 0
+    with U''' terms) is solved densely by QZ (:func:`femmech.analysis.sweep.frozen_modes`):
     frequencies ``Re √λ / 2π``.
 
     Parameters
@@ -589,6 +724,8 @@ def assembled_modes(chain, phi: float, n_modes: int | None = None,
         All modes below f_max, Hz.
     Omega : float
         Drive speed, rad/s.
+    solver : {"auto", "dense", "sparse"}
+        See above (:data:`SOLVERS`).
 
     Returns
     -------
@@ -596,14 +733,21 @@ def assembled_modes(chain, phi: float, n_modes: int | None = None,
         ``method="assembled"``, vectors (n, k) M-normalised; λ < 0 gives negative
         ``freq_hz`` = −√|λ| / 2π.
     """
+    if solver not in SOLVERS:
+        raise ValueError(f"solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
+    if n_modes is not None and (int(n_modes) != n_modes or n_modes < 1):
+        raise ValueError(f"n_modes must be a positive integer, got {n_modes!r}")
     M, _, C = chain.sparse_matrices(float(phi), Omega)
     n = chain.n
     lam_max = None if f_max is None else (2 * np.pi * float(f_max)) ** 2
     asym = abs(C - C.T).max() if n else 0.0
     if asym > SYMMETRY_RTOL * max(abs(C).max(), 1e-300):
         return _assembled_unsymmetric(M, C, n_modes, lam_max)
+    if solver == "auto":
+        every = n_modes is None and f_max is None
+        solver = "dense" if n < DENSE_MAX or every else "sparse"
     with threads.solve_phase():
-        if n <= DENSE_MAX:
+        if solver == "dense":
             lam, V = _dense_pairs(M.toarray(), C.toarray(), n_modes, lam_max)
         else:
             lam, V = _sparse_pairs(M, C, n_modes, lam_max)
@@ -627,7 +771,7 @@ def _sparse_pairs(M, C, n_modes, lam_max):
     from femmech.solve.eigen import solve_symmetric
 
     if lam_max is not None:
-        res = solve_symmetric(C.tocsc(), M.tocsc(), band=(0.0, lam_max))
+        res = solve_symmetric(C.tocsc(), M.tocsc(), band=(0.0, lam_max), dense_below=0)
         lam, V = res.omega2, res.vectors
         keep = lam < lam_max
         lam, V = lam[keep], V[:, keep]
@@ -635,9 +779,9 @@ def _sparse_pairs(M, C, n_modes, lam_max):
             lam, V = lam[:n_modes], V[:, :n_modes]
         return lam, V
     if n_modes is None:
-        raise ValueError(f"the chain has {M.shape[0]} > DENSE_MAX = {DENSE_MAX}"
-                         " coordinates: give n_modes or f_max")
-    res = solve_symmetric(C.tocsc(), M.tocsc(), n_modes=int(n_modes))
+        raise ValueError("the sparse solver needs n_modes or f_max (every mode of the"
+                         " chain: solver='dense')")
+    res = solve_symmetric(C.tocsc(), M.tocsc(), n_modes=int(n_modes), dense_below=0)
     return res.omega2[:n_modes], res.vectors[:, :n_modes]
 
 

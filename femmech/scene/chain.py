@@ -49,8 +49,8 @@ from femmech.scene.units import (
 )
 
 MAX_UNITS = 10_000
-"""Most units of a chain (the assembled model is solved densely up to 2000 coordinates,
-then sparse; the transfer method is O(N))."""
+"""Most units of a chain (the assembled model is solved densely below 400 coordinates,
+then sparse: :data:`femmech.chain.transfer.DENSE_MAX`; the transfer method is O(N))."""
 MAX_HARMONICS = 100
 """Highest drive harmonic k·Ω of a Campbell diagram or a synthesis."""
 MAX_STARTS = 64
@@ -116,7 +116,9 @@ class ChainSpec:
     """A chain of ``n_units`` cam-follower units on a uniform main shaft (SI units).
 
     ``phases`` is a tuple of n_units angles (rad); ``uniform`` says they were given as
-    "uniform" (δ_u = 2π u / N). See :func:`femmech.chain.chain` for the other fields.
+    "uniform" (δ_u = 2π u / N); ``ground_stiffness`` (N/m) is the follower's spring to
+    ground, ``c_g`` of :func:`femmech.chain.follower_unit`. See
+    :func:`femmech.chain.chain` for the other fields.
     """
 
     cam: CamSpec
@@ -139,6 +141,7 @@ class ChainSpec:
     end_length: float | None
     cells: bool
     where: str = field(default="chain", compare=False)
+    ground_stiffness: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -184,7 +187,8 @@ class SynthesisSpec:
 
 _CHAIN_KEYS = ("unit", "n_units", "spacing", "shaft_diameter", "bore", "G", "rho",
                "station_inertia", "phases", "left", "right", "end_length", "cells")
-_UNIT_KEYS = ("kind", "cam", "inertia", "mass", "stiffness", "damping", "force")
+_UNIT_KEYS = ("kind", "cam", "inertia", "mass", "stiffness", "damping", "force",
+              "ground_stiffness")
 _CAM_KEYS = ("law", "return_law", "stroke", "rise", "dwell_top", "return", "dwell_bottom",
              "start")
 
@@ -214,7 +218,9 @@ def read_chain(r: Reader) -> ChainSpec:
                      r.number("rho", DENSITY, STEEL_RHO, positive=True),
                      r.number("station_inertia", INERTIA, 0.0, non_negative=True),
                      phases, uniform, _end(r, "left"), _end(r, "right"), end_length,
-                     r.boolean("cells", False), r.where)
+                     r.boolean("cells", False), r.where,
+                     ground_stiffness=u.number("ground_stiffness", STIFFNESS, 0.0,
+                                               non_negative=True))
     if spec.left.kind == spec.right.kind == "clamped" and n == 1 and end_length is None:
         raise r.error("right", "a single unit without end_length has one node; it cannot"
                                " be clamped at both ends")
@@ -312,7 +318,7 @@ def build_chain(spec: ChainSpec, design: dict | None = None):
     unit = follower_unit(spec.cam.profile(), p.get("hub_inertia", spec.hub_inertia),
                          p.get("follower_mass", spec.follower_mass),
                          p.get("follower_stiffness", spec.follower_stiffness), spec.damping,
-                         spec.force)
+                         spec.force, c_g=spec.ground_stiffness)
     left = spec.left.end(p.get("coupling_stiffness"), p.get("flywheel_inertia"))
     return chain(unit, spec.n_units, spec.spacing,
                  p.get("shaft_diameter", spec.shaft_diameter),

@@ -125,11 +125,10 @@ def test_guided_unit_matches_its_lagrange_derivation(unit):
            "F": g.F(phi, speed, accel)[:, None]}
     for key in "MBCF":
         scale = np.abs(expected[key]).max()
-        # bound: same entries summed in another order (< 10 terms each): <= 10 eps of the largest,
-        # 2.2e-15
+        # bound: sympy-lambdified products: a few ulps of the largest entry
         assert np.abs(got[key] - expected[key]).max() <= 1e-12 * scale, key
     # without the frame coordinate it is the chain's unit (Table 5.1 case 1)
-    # bound: the same closed-form products in another order: a few eps relative
+    # bound: as above
     assert np.allclose(g.C(phi, speed, accel)[:2, :2], unit.C(phi, speed, accel),
                        rtol=1e-13, atol=0)
 
@@ -152,7 +151,7 @@ def test_single_dof_frame_closed_form(unit):
     lam = sla.eigh(C, M, eigvals_only=True)
     a, bq, cq = mf * MASS, kf * MASS + STIFF * (mf + MASS), kf * STIFF
     root = np.sqrt(bq**2 - 4 * a * cq)
-    # bound: dense 2x2 eigh against the quadratic formula: ~eps·cond of the 2x2 pencil
+    # bound: eigh of a 2×2 pencil vs the quadratic formula: ~1e-15
     assert np.allclose(lam, [(bq - root) / (2 * a), (bq + root) / (2 * a)], rtol=1e-12)
 
 
@@ -191,7 +190,7 @@ def test_soft_frame_reduced_matches_unreduced(four):
     for a in (0, 3, 7):
         omega2, _ = full_modes(full, PHI[a], 8)
         f_full = np.sqrt(omega2.real) / (2 * np.pi)
-        # bound: dense LAPACK on both sides: eps λ_max/λ_k of the small frozen pencil (roundoff.py)
+        # bound: the estimate plus eigh round-off ~1e-13
         assert np.abs(result.freq_hz[a] / f_full - 1).max() <= estimate + 1e-10
 
 
@@ -204,8 +203,7 @@ def test_tracked_sweep_of_the_coupled_chain(four):
     phi = np.linspace(0.0, 2 * np.pi, 73)
     tracked = sweep(system, phi, n_modes=6)
     plain = sweep(system, phi, n_modes=6, track=False)
-    # bound: the same frozen eigenproblems, only the column order differs: identical values (0
-    # measured)
+    # bound: the same eigh per angle, only sorted: ~1e-15
     assert np.allclose(np.sort(tracked.freq_hz, axis=1), plain.freq_hz, rtol=1e-10)
     assert tracked.mac_step.min() > 0.9
 
@@ -224,7 +222,7 @@ def test_frame_loaded_by_follower_inertia(four):
         force = -MASS * (cam()(psi, 2) * speed**2 + cam()(psi, 1) * accel)
         expected += force * frame_row(fe, node, "uy")
     assert np.count_nonzero(expected) == 4
-    # bound: closed form of a few products: a few eps relative
+    # bound: the same products in another order: a few ulps
     assert np.allclose(F[:system.n_frame], expected, rtol=1e-12, atol=0)
 
 

@@ -29,7 +29,6 @@ def test_torsion_segment_formula():
     # k = G π d⁴ / (32 L), J = ρ π d⁴ L / 32 (solid round shaft, Roark Table 10.1 case 1)
     k, J = torsion_segment(0.5, 0.04, G=80e9, rho=7800.0)
     Ip = np.pi * 0.04**4 / 32
-    # bound: k, J are the formulas evaluated in another order: a few eps
     assert k == pytest.approx(80e9 * Ip / 0.5, rel=1e-14)
     assert J == pytest.approx(7800.0 * Ip * 0.5, rel=1e-14)
     with pytest.raises(ValueError, match="bore"):
@@ -41,9 +40,10 @@ def test_unit_matrices_follow_table_5_1(unit):
     phi = np.radians(60.0)  # mid-rise: U' at its largest
     U1 = cam()(phi, 1)
     M, C = unit.M(phi), unit.C(phi, 0.0)
-    # bound: closed form of a few products (M, C entries ~1): a few eps
+    # bound: sympy-lambdified products of O(1) factors: a few ulps
     assert np.allclose(M, [[J_HUB + MASS * U1**2, MASS * U1], [MASS * U1, MASS]],
                        rtol=1e-13, atol=0)
+    # bound: as above
     assert np.allclose(C, [[0, 0], [0, STIFF]], rtol=1e-13, atol=1e-12)
 
 
@@ -65,8 +65,9 @@ def test_two_unit_chain_matches_hand_assembly(unit):
     C_hand[np.ix_([2, 3], [2, 3])] += Cu[1]
     C_hand[np.ix_([0, 2], [0, 2])] += k * np.array([[1, -1], [-1, 1]])
     C_hand[0, 0] += 5e4
-    # bound: the same sums in another order: a few eps relative
+    # bound: the same sums in another order: a few ulps
     assert np.allclose(M, M_hand, rtol=1e-14, atol=0)
+    # bound: as above
     assert np.allclose(C, C_hand, rtol=1e-14, atol=0)
     assert not B.any()
     assert np.allclose(ch.M(phi), M)
@@ -82,24 +83,22 @@ def test_clamped_end_removes_its_rotation(unit):
     k_stub = torsion_segment(0.1, 0.04)[0]
     k = torsion_segment(0.25, 0.04)[0]
     C = ch.sparse_matrices(0.0)[2].toarray()
-    # bound: one sum of two terms: 1 ulp
     assert C[0, 0] == pytest.approx(k_stub + k, rel=1e-14)
     # a unit on a clamped node keeps its follower
     ch2 = chain(unit, 2, 0.25, 0.04, left=End.fixed())
     assert ch2.unit_dofs.tolist() == [[-1, 0], [1, 2]]
     lam = np.linalg.eigvalsh(np.linalg.solve(ch2.M(0.0), ch2.C(0.0)))  # M, C at a dwell
-    # bound: dense eigvalsh of M⁻¹C of a small chain: ~eps·cond(M)·λ_max/λ
+    # bound: a dwell root is exactly c/m; eigh ~1e-13 relative
     assert np.isclose(np.sort(lam), STIFF / MASS, rtol=1e-9).sum() >= 1
 
 
 def test_cells_give_equal_node_inertias(unit):
     ch = chain(unit, 5, 0.25, 0.04, cells=True, station_inertia=1e-3)
-    # bound: the same inertia formula per node: equal to the last bits
+    # bound: sums of the same two doubles: 1 ulp
     assert np.allclose(ch.node_inertia, ch.node_inertia[0], rtol=1e-15)
     plain = chain(unit, 5, 0.25, 0.04, station_inertia=1e-3)
     # total inertia: N spacings of shaft (cells) against N − 1 (plain)
     Js = torsion_segment(0.25, 0.04)[1]
-    # bound: a sum of N = 5 terms minus another: ~N eps of the sums, relative to Js
     assert ch.node_inertia.sum() - plain.node_inertia.sum() == pytest.approx(Js, rel=1e-12)
 
 
@@ -148,6 +147,6 @@ def test_force_vector_scatters_the_units_loads():
     U1 = cam()(0.5 + np.array([0.0, 1.0, 2.0]), 1)
     # node 0 is clamped: its rotation row is dropped, its follower row stays
     expected = np.array([-10.0, -10 * U1[1], -10.0, -10 * U1[2], -10.0])
-    # bound: a few products of O(10) values: a few eps
+    # bound: scatter of the same values: exact up to summation order
     assert np.allclose(F, expected, rtol=1e-12, atol=1e-12)
     assert ch.F(np.zeros((2, 3))).shape == (2, 3, ch.n)

@@ -88,7 +88,7 @@ def test_laplacian_eigenpairs_symbolic(N, case):
     for mu, v in _symbolic_waves(N, case):
         residual = (L * v - 2 * (1 - sp.cos(mu)) * v).applyfunc(
             lambda e: sp.nsimplify(sp.simplify(sp.expand_trig(e)), rational=False))
-        # bound: sympy at 30 digits on an exactly-zero residual: ~1e-30
+        # bound: 30-digit evaluation of an identity that is exactly zero
         assert all(abs(complex(sp.N(e, 30))) < 1e-25 for e in residual)
 
 
@@ -139,7 +139,7 @@ def test_wave_basis_block_diagonalises_assembled_matrices(N, case):
         syms = (m11, m12, m22, c11, c12, c22, J, k)
         coeffs = [sp.expand(e).coeff(x) for e in diff for x in syms] + [
             sp.expand(e).subs(dict.fromkeys(syms, 0)) for e in diff]
-        # bound: sympy at 50 digits on exactly-zero coefficients: ~1e-50
+        # bound: 50-digit evaluation of exact zeros
         assert max(abs(sp.N(q, 50)) for q in coeffs) < 1e-40
 
 
@@ -171,9 +171,9 @@ def test_wave_helpers_match_the_laplacian():
             _, mu = wave_numbers(N, case)
             V = wave_vectors(N, case)
             L = laplacian(N, case)
-            # bound: orthonormal cosine/sine vectors of O(1) entries, N <= 40 terms per product: ~N
-            # eps
+            # bound: eigh of an (N, N) Laplacian: ~N eps
             assert np.allclose(V.T @ V, np.eye(N), atol=1e-13)
+            # bound: as above
             assert np.allclose(L @ V, V * (2 - 2 * np.cos(mu)), atol=1e-13)
 
 
@@ -189,17 +189,19 @@ def test_cyclic_equals_assembled(unit, N, case, phi):
     assert got.method == "cyclic"
     assert got.freq_hz.shape == (ch.n,)
     # 1e-10 relative (brief); the rigid mode (free–free) in λ: LAPACK leaves it at
-    # bound: ~1e-16 λ_max, i.e. f ~ 1e-8 f_max, so zero is checked as λ < 1e-13 λ_max;
-    # the elastic ones: eigh round-off eps λ_max/λ (roundoff.py)
+    # ~1e-16 λ_max, i.e. f ~ 1e-8 f_max, so zero is checked as λ < 1e-13 λ_max
+    # bound: rigid roots: eigh's ±eps·λ_max
     rigid = ref**2 < 1e-13 * ref.max() ** 2
+    # bound: eigh of the small problem vs of the assembled chain: both ~1e-13
     assert np.allclose(got.freq_hz[~rigid], ref[~rigid], rtol=1e-10, atol=0)
-    # bound: rigid λ = 0 ± eps λ_max of dense eigh (comment above)
+    # bound: as above (rigid)
     assert np.all(got.freq_hz[rigid] ** 2 < 1e-13 * ref.max() ** 2)
     assert rigid.sum() == (case == "free-free")
     M, C = ch.M(phi), ch.C(phi)
     V = got.vectors
-    # bound: M-orthonormal eigh vectors: ~n eps·cond(M)
+    # bound: orthonormality after one Cholesky and eigh: ~1e-14
     assert np.allclose(V.T @ M @ V, np.eye(ch.n), atol=1e-12)
+    # bound: residual ~eps·‖C‖ · n
     assert np.allclose(C @ V, M @ V * got.omega2, atol=1e-10 * np.abs(C).max())
     # every wave number appears m = 2 times
     assert np.all(np.bincount(got.label - got.label.min()) == 2)
@@ -208,7 +210,7 @@ def test_cyclic_equals_assembled(unit, N, case, phi):
 def test_n1_single_node_uses_its_ground_spring(unit):
     ch = chain(unit, 1, 0.25, 0.04, left=End.elastic(3e4), right=End.elastic(2e4))
     assert end_case(ch) == "grounded-free"
-    # bound: closed form against dense eigh of a small pencil: eps λ_max/λ (roundoff.py)
+    # bound: the same 1-node problem in closed form: ~1e-15
     assert np.allclose(cyclic_modes(ch, PHI_RISE).freq_hz, assembled_freq(ch, PHI_RISE),
                        rtol=1e-12)
 
@@ -229,6 +231,7 @@ def test_every_branch_fills_its_pass_band_with_n_roots(unit, N, case):
     ch = uniform(unit, N, case)
     bands, gaps = pass_bands(ch, PHI_RISE)
     f = assembled_freq(ch, PHI_RISE)
+    # bound: band edges from a 2×2 eigh: ~1e-15 relative
     tol = 1e-10 * f.max()
     for lo, hi in bands:
         assert np.count_nonzero((f >= lo - tol) & (f <= hi + tol)) == N
@@ -237,7 +240,6 @@ def test_every_branch_fills_its_pass_band_with_n_roots(unit, N, case):
     Jr = ch.node_inertia[0] + J_HUB
     U1 = ch.unit.M(PHI_RISE)[0, 1] / MASS
     Jt = Jr + MASS * U1**2
-    # bound: closed forms √(k/m)/(2π) evaluated in two orders: a few eps
     assert g_lo == pytest.approx(np.sqrt(STIFF / MASS) / (2 * np.pi), rel=1e-13)
     assert g_hi == pytest.approx(np.sqrt(STIFF * Jt / (MASS * Jr)) / (2 * np.pi), rel=1e-13)
     assert not np.any((f > g_lo + tol) & (f < g_hi - tol))
@@ -272,11 +274,10 @@ def test_dwell_gives_an_exactly_repeated_follower_root(unit):
     ch = uniform(unit, 7)
     got = cyclic_modes(ch, PHI_DWELL, vectors=False)
     f_f = np.sqrt(STIFF / MASS) / (2 * np.pi)
-    # bound: follower modes at √(k/m) exactly in the dwell (closed form): a few eps
+    # bound: a dwell root is exactly c/m: eigh ~1e-15 on the 2×2 problem
     assert np.count_nonzero(np.isclose(got.freq_hz, f_f, rtol=1e-12)) == 7
     ref = assembled_freq(ch, PHI_DWELL)
-    # bound: closed-form cyclic λ against dense eigh: eps λ_max/λ_k of the chain pencil
-    # (roundoff.py)
+    # bound: eigh vs eigh: ~1e-13
     assert np.allclose(got.freq_hz[1:], ref[1:], rtol=1e-10, atol=0)
 
 

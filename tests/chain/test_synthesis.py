@@ -71,7 +71,7 @@ def test_one_dof_margin_below_band():
     J = 0.1
     k = J * (TWO_PI * 9.0) ** 2
     m = resonance_margin(one_dof(k, J), (600, 900), 3)
-    assert m.value == pytest.approx(0.1, rel=1e-12)  # bound: round-off of one 1x1 eigh
+    assert m.value == pytest.approx(0.1, rel=1e-12)  # round-off of one 1x1 eigh
     assert (m.harmonic, m.branch, m.side) == (1, 0, "below")
     assert m.band_hz == pytest.approx((10.0, 15.0))
 
@@ -79,11 +79,9 @@ def test_one_dof_margin_below_band():
 def test_one_dof_margin_inside_and_above():
     J = 0.1
     inside = resonance_margin(one_dof(J * (TWO_PI * 12.0) ** 2, J), (600, 900), 2)
-    # bound: one 1x1 eigh and two divisions: a few eps
     assert inside.value == pytest.approx(-0.2, rel=1e-12)  # max(1 - 12/10, 12/15 - 1)
     assert inside.side == "inside"
     above = resonance_margin(one_dof(J * (TWO_PI * 32.0) ** 2, J), (600, 900), 2)
-    # bound: one 1x1 eigh and a division: a few eps
     assert above.value == pytest.approx(32 / 30 - 1, rel=1e-12)  # band 2 = [20, 30] Hz
     assert (above.harmonic, above.side) == (2, "above")
 
@@ -95,7 +93,6 @@ def test_margin_critical_angle_of_varying_inertia():
     m = resonance_margin(one_dof(k, J, eps), (600, 900), 2, n_angles=72)
     f_min = np.sqrt(k / (J * (1 + eps / 2))) / TWO_PI
     assert m.angle == 0.0
-    # bound: 2x2 eigh at the minimum of f(φ) (closed form): ~eps·cond(M)
     assert m.frequency_hz == pytest.approx(f_min, rel=1e-12)
     assert m.value == pytest.approx(f_min / 30 - 1, rel=1e-12)
 
@@ -127,10 +124,9 @@ def test_ks_formula_sympy():
     point = {f1: sympy.Rational(93, 10), f2: sympy.Rational(161, 10), rho: 40}
     value, grad = ks_margin(np.array([[9.3, 16.1]]), np.array(lo, float),
                             np.array(hi, float), 40.0)
-    # bound: the KS function of two numbers against sympy: a few eps of exp/log
     assert value == pytest.approx(float(ks.subs(point)), rel=1e-12)
     exact = [float(sympy.diff(ks, f).subs(point)) for f in (f1, f2)]
-    # bound: gradient of KS (exp ratios of O(1) terms): ~10 eps relative
+    # bound: analytic derivative vs sympy: round-off ~1e-14
     np.testing.assert_allclose(grad[0], exact, rtol=1e-10)
     # the nested form: exp(-ρ smoothmax(a, b)) = 1/(e^{ρa} + e^{ρb})
     a, b = sympy.symbols("a b", real=True)
@@ -152,9 +148,9 @@ def test_fox_kapoor_sympy():
     w, V = frozen_eigen(Mn[None], Cn[None])
     fk = [V[0, :, i] @ (dC - w[0, i] * dM) @ V[0, :, i] for i in range(2)]
     by_root = sorted(zip((float(r.subs(p, p0)) for r in roots), exact, strict=True))
-    # bound: 2x2 eigh against sympy roots: ~eps·cond(M)
+    # bound: eigh vs sympy roots: ~1e-15
     np.testing.assert_allclose(w[0], [r for r, _ in by_root], rtol=1e-12)
-    # bound: eigenvalue derivative vᵀ(dC - λ dM)v, cancelling terms: ~eps·cond(M)·λ/|dλ|
+    # bound: Fox–Kapoor vs sympy: ~1e-13
     np.testing.assert_allclose(fk, [d for _, d in by_root], rtol=1e-10)
 
 
@@ -163,7 +159,7 @@ def test_one_dof_frequency_sympy():
     k, J, lam = sympy.symbols("k J lambda", positive=True)
     assert sympy.solve(k - lam * J, lam) == [k / J]
     bands = frequency_bands(one_dof(400.0, 0.25))
-    # bound: 1x1 eigh: a few eps
+    # bound: eigh of a 1×1 problem: exact to ~1e-16
     np.testing.assert_allclose(bands.freq_hz, np.sqrt(400 / 0.25) / TWO_PI, rtol=1e-13)
 
 
@@ -193,7 +189,7 @@ def test_gradient_through_a_cluster_of_repeated_eigenvalues():
         return chain(follower_unit(CAM, 1e-3, 0.5, v["c"]), 5, 0.2, 0.03,
                      left=End.elastic(1e4, v["J"]))
     f = frequency_bands(in_phase({"J": 0.05, "c": 2e5}), n_angles=6).freq_hz[0]
-    # bound: the in-phase cluster is exact (identical units), eigh splits it by ~eps λ_max/λ
+    # bound: a repeated root from identical units in phase: eigh splits it by ~1e-13
     assert np.ptp(f[1:5]) < 1e-9 * f[1]  # the cluster is there
     values = {"J": 0.05, "c": 2.1e5}  # f cluster ≈ 103 Hz: KS dominated by it (band 4)
     ks, grad, _ = margin_sensitivities(in_phase, PARAMS, values, SPEED, K, n_angles=12)

@@ -97,8 +97,9 @@ def test_condensed_stiffness_numbers_match_formula():
     Mu, _, Cu = ch.unit_matrices(0.4)
     D = Cu[:, None] - lam[:, None, None] * Mu[:, None]  # (units, L, 2, 2)
     exact = D[..., 0, 0] - D[..., 0, 1] ** 2 / D[..., 1, 1]
-    # bound: modal sum against direct elimination: same numbers to round-off (~1e-12 here,
+    # modal sum against direct elimination: same numbers to round-off (~1e-12 here,
     # the terms are ~1e3 times the result near μ)
+    # bound: modal sum vs direct elimination, terms ~1e3 × the result near μ: ~1e-13
     assert np.allclose(tr._unit_stiffness(fz, lam), exact, rtol=1e-10, atol=0)
 
 
@@ -141,17 +142,18 @@ def test_transfer_agrees_with_assembled(name, phi_deg):
     assert modes.converged.all()
     assert len(modes) == ch.n
     got = modes.omega2
-    # bound: rigid λ = 0 ± eps λ_max (roundoff.py), far below the elastic ones
     elastic = lam > 1e-9 * lam[-1]  # free-free chains: one rigid mode, λ = 0 ± round-off
     assert np.all(got[~elastic] == 0.0)
-    # bound: bisection to rtol 1e-12 on the exact count; eigh's own error ~1e-13 relative
+    # bisection to rtol 1e-12 on the exact count; eigh's own error ~1e-13 relative
     rel = np.abs(got[elastic] - lam[elastic]) / lam[elastic]
+    # bound: bisection rtol 1e-12 on λ; eigh ~eps·λ_max/λ ≤ 1e-11 on these roots
     assert rel.max() <= 1e-9
     V = modes.vectors
     M, _, C = ch.sparse_matrices(phi)
     res = (np.linalg.norm(C @ V[:, elastic] - (M @ V[:, elastic]) * got[elastic], axis=0)
            / np.linalg.norm(C @ V[:, elastic], axis=0))
-    # bound: round-off level: |δλ|/λ ≤ 1e-12 from the bracket, inverse iteration to 1e-12
+    # round-off level: |δλ|/λ ≤ 1e-12 from the bracket, inverse iteration to 1e-12
+    # bound: inverse iteration to ROUNDOFF_RESIDUAL 1e-14 plus |δλ|/λ ≤ 1e-12
     assert res.max() <= 5e-12
     # M-orthonormal; close roots (relative gaps down to 1e-8 in the follower cluster)
     # are Rayleigh–Ritz-ed together, so the Gram matrix is I to ~1e-8
@@ -162,14 +164,14 @@ def test_assembled_modes_reference_paths():
     ch = phased(30, left=End.fixed())
     dense = assembled_modes(ch, 0.7, n_modes=12)
     band = assembled_modes(ch, 0.7, f_max=dense.freq_hz[-1] * (1 + 1e-9))
-    # bound: the same dense eigh twice (count vs band): identical to round-off, a few eps
+    # bound: the same dense eigh (subset vs band selection): identical to ~1 ulp
     assert np.allclose(dense.freq_hz, band.freq_hz, rtol=1e-12)
     assert dense.vectors.shape == (ch.n, 12)
     big = phased(1100, left=End.fixed())  # n = 2199 > DENSE_MAX: sparse shift-invert
     sparse = assembled_modes(big, 0.7, n_modes=6)
     mine = transfer_modes(big, 0.7, n_modes=6, vectors=False)
     # Lanczos with residual ≤ 1e-6 relative (femmech.solve); eigenvalues converge quadratically
-    # bound: Lanczos Ritz residual 1e-12 -> eigenvalue error ~1e-24, plus eps λ_max/λ (roundoff.py)
+    # bound: Lanczos residual ≤ 1e-6 -> λ to ~1e-12 (quadratic); bisection 1e-12
     assert np.allclose(sparse.freq_hz, mine.freq_hz, rtol=1e-9)
 
 
@@ -200,9 +202,10 @@ def test_no_missed_root_in_a_band():
     band = (f > 95) & (f < 110)  # the crowded band around the follower frequency 100.66 Hz
     modes = transfer_modes(ch, phi, f_max=110.0, vectors=False)
     assert len(modes) == np.count_nonzero(f < 110)
-    # bound: bisection rtol 1e-12 on the roots against eigh's eps λ_max/λ (roundoff.py)
+    # bound: bisection rtol 1e-12 on λ; eigh ~eps·λ_max/λ ≤ 1e-11 on these roots
     assert np.allclose(modes.freq_hz[modes.freq_hz > 95], f[band], rtol=1e-10)
     lowest = transfer_modes(ch, phi, n_modes=7, vectors=False)
+    # bound: bisection rtol 1e-12 on λ; eigh ~eps·λ_max/λ ≤ 1e-11 on these roots
     assert np.allclose(lowest.freq_hz, f[:7], rtol=1e-10)
     assert np.array_equal(lowest.count, np.arange(7))  # simple roots: J below root i = i
 
@@ -215,19 +218,21 @@ def test_repeated_follower_root_in_dwell():
     phi = np.radians(150.0)
     modes = transfer_modes(ch, phi, n_modes=ch.n)  # 2n − 1: the clamped node is gone
     lam = dense_eigenvalues(ch, phi)
-    # bound: bisection rtol 1e-12 against eigh's eps λ_max/λ (roundoff.py)
+    # bound: bisection rtol 1e-12 on λ; eigh ~eps·λ_max/λ ≤ 1e-11 on these roots
     assert np.allclose(modes.omega2, lam, rtol=1e-11)
+    # bound: a dwell root is exactly c/m; bisection rtol 1e-12 (f: 5e-13)
     at = np.flatnonzero(np.abs(modes.omega2 / (STIFF / MASS) - 1) < 1e-12)
     assert at.size == n
     assert np.all(modes.count[at] == modes.count[at[0]])  # one bracket, jump n
     V = modes.vectors[:, at]
     M, _, C = ch.sparse_matrices(phi)
     follower = ch.unit_dofs[:, 1]
-    # bound: follower-only modes: shaft components are round-off, ~n eps of M-unit vectors
+    # bound: decoupled followers: shaft rotations 0 up to block inverse iteration round-off ~1e-15
     assert np.abs(V[ch.node_dof[ch.node_dof >= 0]]).max() <= 1e-12  # shaft at rest
+    # bound: Löwdin/Ritz M-orthonormalisation to round-off ~1e-15
     assert np.allclose(V.T @ (M @ V), np.eye(n), atol=1e-12)
     assert np.linalg.matrix_rank(V[follower], tol=1e-8) == n  # spans all followers
-    # bound: residual of exact eigenvectors (closed form): ~n eps ‖C V‖, n = 30
+    # bound: residual at round-off (ROUNDOFF_RESIDUAL 1e-14)
     assert np.linalg.norm(C @ V - (M @ V) * (STIFF / MASS)) <= 1e-12 * np.linalg.norm(C @ V)
 
 
@@ -256,10 +261,11 @@ def test_huge_stiffness_contrast():
                                                   + (mp.mpf(k[i]) if i < n - 1 else 0))
         exact = [float(mp.findroot(lambda x: mp.det(Cm - x * Mm), mp.mpf(lam)))
                  for lam in modes.omega2[1:]]
-    # bound: mpmath roots to 15+ digits against bisection rtol 1e-12 (transfer_modes)
+    # bound: 40-digit reference; bisection rtol 1e-12 on λ
     assert np.allclose(modes.omega2[1:], exact, rtol=1e-12, atol=0)
     lam = dense_eigenvalues(ch, 1.1)
-    # bound: eigh: within its own bound, ~eps λ_max absolute
+    # eigh: within its own bound, ~eps λ_max absolute
+    # bound: eigh's absolute error ~eps·λ_max plus the bisection's 1e-12
     assert np.all(np.abs(modes.omega2[1:] - lam[1:4]) <= 1e-9 * lam[1:4] + 100 * np.finfo(
         float).eps * lam[-1])
 
@@ -330,6 +336,6 @@ def test_negative_root_divergence():
     assert lam[0] < 0  # the reference agrees there is one
     modes = transfer_modes(ch, 0.3, n_modes=4)
     assert modes.freq_hz[0] < 0
-    # bound: bisection rtol 1e-12 on the roots against eigh's eps λ_max/λ (roundoff.py)
+    # bound: bisection rtol 1e-12 on λ; eigh ~eps·λ_max/λ ≤ 1e-11 on these roots
     assert np.allclose(modes.omega2, lam[:4], rtol=1e-10)
     assert count_below(ch, 0.3, 0.0) == 1
