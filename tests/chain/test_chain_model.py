@@ -29,6 +29,7 @@ def test_torsion_segment_formula():
     # k = G π d⁴ / (32 L), J = ρ π d⁴ L / 32 (solid round shaft, Roark Table 10.1 case 1)
     k, J = torsion_segment(0.5, 0.04, G=80e9, rho=7800.0)
     Ip = np.pi * 0.04**4 / 32
+    # bound: k, J are the formulas evaluated in another order: a few eps
     assert k == pytest.approx(80e9 * Ip / 0.5, rel=1e-14)
     assert J == pytest.approx(7800.0 * Ip * 0.5, rel=1e-14)
     with pytest.raises(ValueError, match="bore"):
@@ -83,6 +84,7 @@ def test_clamped_end_removes_its_rotation(unit):
     k_stub = torsion_segment(0.1, 0.04)[0]
     k = torsion_segment(0.25, 0.04)[0]
     C = ch.sparse_matrices(0.0)[2].toarray()
+    # bound: one sum of two terms: 1 ulp
     assert C[0, 0] == pytest.approx(k_stub + k, rel=1e-14)
     # a unit on a clamped node keeps its follower
     ch2 = chain(unit, 2, 0.25, 0.04, left=End.fixed())
@@ -99,6 +101,7 @@ def test_cells_give_equal_node_inertias(unit):
     plain = chain(unit, 5, 0.25, 0.04, station_inertia=1e-3)
     # total inertia: N spacings of shaft (cells) against N − 1 (plain)
     Js = torsion_segment(0.25, 0.04)[1]
+    # bound: a sum of N = 5 terms minus another: ~N eps of the sums, relative to Js
     assert ch.node_inertia.sum() - plain.node_inertia.sum() == pytest.approx(Js, rel=1e-12)
 
 

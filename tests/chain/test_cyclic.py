@@ -240,6 +240,7 @@ def test_every_branch_fills_its_pass_band_with_n_roots(unit, N, case):
     Jr = ch.node_inertia[0] + J_HUB
     U1 = ch.unit.M(PHI_RISE)[0, 1] / MASS
     Jt = Jr + MASS * U1**2
+    # bound: closed forms √(k/m)/(2π) evaluated in two orders: a few eps
     assert g_lo == pytest.approx(np.sqrt(STIFF / MASS) / (2 * np.pi), rel=1e-13)
     assert g_hi == pytest.approx(np.sqrt(STIFF * Jt / (MASS * Jr)) / (2 * np.pi), rel=1e-13)
     assert not np.any((f > g_lo + tol) & (f < g_hi - tol))

@@ -71,7 +71,7 @@ def test_one_dof_margin_below_band():
     J = 0.1
     k = J * (TWO_PI * 9.0) ** 2
     m = resonance_margin(one_dof(k, J), (600, 900), 3)
-    assert m.value == pytest.approx(0.1, rel=1e-12)  # round-off of one 1x1 eigh
+    assert m.value == pytest.approx(0.1, rel=1e-12)  # bound: round-off of one 1x1 eigh
     assert (m.harmonic, m.branch, m.side) == (1, 0, "below")
     assert m.band_hz == pytest.approx((10.0, 15.0))
 
@@ -79,9 +79,11 @@ def test_one_dof_margin_below_band():
 def test_one_dof_margin_inside_and_above():
     J = 0.1
     inside = resonance_margin(one_dof(J * (TWO_PI * 12.0) ** 2, J), (600, 900), 2)
+    # bound: one 1x1 eigh and two divisions: a few eps
     assert inside.value == pytest.approx(-0.2, rel=1e-12)  # max(1 - 12/10, 12/15 - 1)
     assert inside.side == "inside"
     above = resonance_margin(one_dof(J * (TWO_PI * 32.0) ** 2, J), (600, 900), 2)
+    # bound: one 1x1 eigh and a division: a few eps
     assert above.value == pytest.approx(32 / 30 - 1, rel=1e-12)  # band 2 = [20, 30] Hz
     assert (above.harmonic, above.side) == (2, "above")
 
@@ -93,6 +95,7 @@ def test_margin_critical_angle_of_varying_inertia():
     m = resonance_margin(one_dof(k, J, eps), (600, 900), 2, n_angles=72)
     f_min = np.sqrt(k / (J * (1 + eps / 2))) / TWO_PI
     assert m.angle == 0.0
+    # bound: 2x2 eigh at the minimum of f(φ) (closed form): ~eps·cond(M)
     assert m.frequency_hz == pytest.approx(f_min, rel=1e-12)
     assert m.value == pytest.approx(f_min / 30 - 1, rel=1e-12)
 
@@ -124,6 +127,7 @@ def test_ks_formula_sympy():
     point = {f1: sympy.Rational(93, 10), f2: sympy.Rational(161, 10), rho: 40}
     value, grad = ks_margin(np.array([[9.3, 16.1]]), np.array(lo, float),
                             np.array(hi, float), 40.0)
+    # bound: the KS function of two numbers against sympy: a few eps of exp/log
     assert value == pytest.approx(float(ks.subs(point)), rel=1e-12)
     exact = [float(sympy.diff(ks, f).subs(point)) for f in (f1, f2)]
     # bound: analytic derivative vs sympy: round-off ~1e-14

@@ -142,6 +142,7 @@ def test_transfer_agrees_with_assembled(name, phi_deg):
     assert modes.converged.all()
     assert len(modes) == ch.n
     got = modes.omega2
+    # bound: rigid λ = 0 ± eps λ_max (roundoff.py), far below the elastic ones
     elastic = lam > 1e-9 * lam[-1]  # free-free chains: one rigid mode, λ = 0 ± round-off
     assert np.all(got[~elastic] == 0.0)
     # bisection to rtol 1e-12 on the exact count; eigh's own error ~1e-13 relative
