@@ -242,7 +242,9 @@ def _retire(retired: Path, out: Path, ours: set[str]) -> None:
         notes.append(f"could not move {_listed(stuck)}; the previous folder is left as"
                      f" {retired}")
     if notes:
-        warnings.warn(FemmechWarning(f"--out {out}: " + "; ".join(notes)), stacklevel=4)
+        # stacklevel 5: past _replace or _remove_stale, staged_output and contextlib, to
+        # the with statement of the caller
+        warnings.warn(FemmechWarning(f"--out {out}: " + "; ".join(notes)), stacklevel=5)
 
 
 def _listed(paths: list[str], at_most: int = 10) -> str:
