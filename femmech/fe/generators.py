@@ -176,8 +176,11 @@ def _divisions(m: int, member, a: str, b: str, points, index: dict) -> int:
         raise ValueError(f"member {m} ({member['group']!r}): joints {a!r} and {b!r}"
                          f" are {length} m apart")
     k = member.get("divisions") or length / member["element_size"]
-    if not (np.isfinite(k) and round(k) <= MAX_ELEMENTS_PER_MEMBER):
-        raise ValueError(f"member {m} ({member['group']!r}) from {a!r} to {b!r}: {k:.6g}"
+    # a sized count may be a Python int beyond float64 (e.g. for f_max = 1e29 Hz)
+    if not (k <= MAX_ELEMENTS_PER_MEMBER if isinstance(k, int)
+            else np.isfinite(k) and round(k) <= MAX_ELEMENTS_PER_MEMBER):
+        shown = f"{k:.6g}" if not isinstance(k, int) or k < 10**300 else f"1e+{len(str(k)) - 1}"
+        raise ValueError(f"member {m} ({member['group']!r}) from {a!r} to {b!r}: {shown}"
                          f" elements (length {length:.6g} m); at most"
                          f" {MAX_ELEMENTS_PER_MEMBER} per member")
     return max(1, round(k))
@@ -253,6 +256,23 @@ def surface_cells(grid: np.ndarray, kind: str) -> np.ndarray:
     return np.vstack([t1, t2])
 
 
+def rectangular_plate_size(nx: int, ny: int, kind: str = "quad") -> tuple[int, int]:
+    """(nodes, cells) :func:`rectangular_plate` makes, computed without building it."""
+    p = _surface_kind(kind)
+    return (p * ny + 1) * (p * nx + 1), nx * ny * (2 if kind.startswith("triangle") else 1)
+
+
+def box_size(nx: int, ny: int, nz: int, end_plates: bool = True,
+             kind: str = "quad") -> tuple[int, int]:
+    """(nodes, cells) :func:`box` makes, computed without building it."""
+    p = _surface_kind(kind)
+    n_tube = (p * nx + 1) * p * (2 * ny + 2 * nz)
+    n_end = (p * ny - 1) * (p * nz - 1)
+    per_quad = 2 if kind.startswith("triangle") else 1
+    return (n_tube + 2 * n_end * end_plates,
+            per_quad * (2 * nx * (ny + nz) + 2 * ny * nz * end_plates))
+
+
 def _check_size(n_nodes: int, n_cells: int, what: str) -> None:
     if n_nodes > MAX_NODES or n_cells > MAX_CELLS:
         raise ValueError(f"{what} would have {n_cells} elements and {n_nodes} nodes; at most"
@@ -286,8 +306,8 @@ def rectangular_plate(a: float, b: float, nx: int, ny: int, kind: str = "quad",
     _counts(nx=nx, ny=ny)
     p = _surface_kind(kind)
     rows, cols = p * ny + 1, p * nx + 1
-    _check_size(rows * cols, nx * ny * (2 if kind.startswith("triangle") else 1),
-                f"rectangular_plate({nx} x {ny}, {kind!r})")
+    _check_size(*rectangular_plate_size(nx, ny, kind), f"rectangular_plate({nx} x {ny},"
+                f" {kind!r})")
     X, Y = np.meshgrid(np.linspace(0.0, a, cols), np.linspace(0.0, b, rows))
     points = np.column_stack([X.ravel(), Y.ravel(), np.zeros(X.size)]) + np.asarray(
         origin, dtype=float)
@@ -342,10 +362,8 @@ def box(length: float, width: float, height: float, nx: int, ny: int, nz: int,
     per = p * (2 * ny + 2 * nz)  # perimeter nodes of one section
     n_tube = (p * nx + 1) * per
     n_end = (p * ny - 1) * (p * nz - 1)
-    per_quad = 2 if kind.startswith("triangle") else 1
-    _check_size(n_tube + 2 * n_end * end_plates,
-                per_quad * (2 * nx * (ny + nz) + 2 * ny * nz * end_plates),
-                f"box({nx} x {ny} x {nz}, {kind!r})")
+    _check_size(*box_size(nx, ny, nz, end_plates, kind), f"box({nx} x {ny} x {nz},"
+                f" {kind!r})")
     my, mz = p * ny, p * nz
     x = np.linspace(0.0, length, p * nx + 1)
     section = _perimeter(width, height, my, mz)  # (per, 2): y, z

@@ -9,7 +9,12 @@ Every number in a table cell is formatted by :func:`femmech.output.formatting.fo
 (engineering notation, fixed significant digits, no float artefacts); NaN and infinite
 values are highlighted like :class:`Flagged` cells.
 
-Stage 7 (output): uses output.export and output.formatting.
+Every string of a section (titles, paragraphs, warnings, captions, cells, file names, the
+log) is text: the page is built by :func:`femmech.html.element`, which escapes it exactly
+once, so a scene name or group name holding ``<script>`` shows as written and never runs.
+Link targets must be relative paths (:func:`femmech.html.url`).
+
+Stage 7 (output): uses html, output.export and output.formatting.
 """
 
 from __future__ import annotations
@@ -19,8 +24,8 @@ import re
 from dataclasses import dataclass, field
 from numbers import Real
 from pathlib import Path
-from urllib.parse import quote
 
+from femmech.html import Markup, element, fragment
 from femmech.output.export import atomic_path
 from femmech.output.formatting import Quantity, format_value, is_flagged
 
@@ -127,7 +132,7 @@ _NUMBER = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)(e[-+]?\d+)?( ?%| [^\s\d]+)?$")
 """A cell's text that is a number, optionally with a unit: right-aligned."""
 
 
-def _cell(value) -> str:
+def _cell(value) -> Markup:
     """One ``<td>``: class ``flagged`` for Flagged, NaN and infinite values, class
     ``num`` (right-aligned) for numbers."""
     classes = []
@@ -136,72 +141,70 @@ def _cell(value) -> str:
         classes.append("flagged")
     text = _text(value)
     if (isinstance(value, (Quantity, Real)) and not isinstance(value, bool)) or \
-            _NUMBER.match(html.unescape(text)):
+            _NUMBER.match(text):
         classes.append("num")
-    attr = f' class="{" ".join(classes)}"' if classes else ""
-    return f"<td{attr}>{text}</td>"
+    return element("td", text, class_=" ".join(classes) or None)
 
 
 def _text(value) -> str:
+    """The cell's text (not yet escaped: :func:`femmech.html.element` escapes it)."""
     if isinstance(value, Flagged):
-        return html.escape(value.text)
-    if isinstance(value, (Quantity, str)):
-        return html.escape(str(value))
-    if isinstance(value, Real) and not isinstance(value, bool):
-        return html.escape(format_value(value))
-    return html.escape(str(value))
+        return str(value.text)
+    if isinstance(value, Real) and not isinstance(value, (bool, Quantity)):
+        return format_value(value)
+    return str(value)
 
 
 def render_table(table: Table) -> str:
     """HTML of one table; numbers formatted by
     :func:`~femmech.output.formatting.format_value`."""
-    head = "".join(f"<th>{_text(h)}</th>" for h in table.header)
-    body = "".join("<tr>" + "".join(_cell(c) for c in row) + "</tr>" for row in table.rows)
-    note = f'<p class="note">{html.escape(table.note)}</p>' if table.note else ""
-    return (f"<table><caption>{html.escape(table.caption)}</caption><thead><tr>{head}</tr>"
-            f"</thead><tbody>{body}</tbody></table>{note}")
+    head = element("thead", element("tr", [element("th", _text(h)) for h in table.header]))
+    body = element("tbody", [element("tr", [_cell(c) for c in row]) for row in table.rows])
+    note = element("p", table.note, class_="note") if table.note else None
+    return fragment(element("table", element("caption", table.caption), head, body), note)
 
 
-def _figure(fig: Figure) -> str:
-    return (f'<figure><a href="{quote(fig.file)}"><img src="{quote(fig.file)}"'
-            f' alt="{html.escape(fig.caption)}"></a><figcaption>{html.escape(fig.caption)}'
-            "</figcaption></figure>")
+def _figure(fig: Figure) -> Markup:
+    return element("figure", element("a", element("img", src=fig.file, alt=fig.caption),
+                                     href=fig.file), element("figcaption", fig.caption))
 
 
 def render_section(section: Section, anchor: str) -> str:
     """HTML of one section."""
-    parts = [f'<section id="{anchor}"><h2>{html.escape(section.title)}</h2>']
-    parts += [f"<p>{html.escape(p)}</p>" for p in section.paragraphs]
-    parts += [f'<p class="warning">&#9888; {html.escape(w)}</p>' for w in section.warnings]
+    parts = [element("h2", section.title)]
+    parts += [element("p", p) for p in section.paragraphs]
+    parts += [element("p", Markup("&#9888; "), w, class_="warning") for w in section.warnings]
     parts += [render_table(t) for t in section.tables]
     if section.figures:
-        cls = ' class="gallery"' if section.gallery else ""
-        parts.append(f"<div{cls}>" + "".join(_figure(f) for f in section.figures) + "</div>")
+        parts.append(element("div", [_figure(f) for f in section.figures],
+                             class_="gallery" if section.gallery else None))
     if section.preformatted:
-        parts.append("<pre>" + html.escape("\n".join(section.preformatted)) + "</pre>")
+        parts.append(element("pre", "\n".join(section.preformatted)))
     if section.files:
-        links = "".join(f'<li><a href="{quote(f)}">{html.escape(f)}</a></li>'
-                        for f in section.files)
-        parts.append(f'<ul class="files">{links}</ul>')
-    parts.append("</section>")
-    return "\n".join(parts)
+        parts.append(element("ul", [element("li", element("a", f, href=f))
+                                    for f in section.files], class_="files"))
+    # the section's lines are joined by newlines, as the page always was
+    return Markup(f'<section id="{html.escape(anchor, quote=True)}">'
+                  + "\n".join(parts) + "\n</section>")
 
 
 def render_report(title: str, meta: str, sections, log_lines=()) -> str:
     """The whole page as a string."""
     anchors = [f"s{i + 1}" for i in range(len(sections))]
-    nav = "".join(f'<a href="#{a}">{html.escape(s.title)}</a>'
-                  for a, s in zip(anchors, sections, strict=True))
+    nav = element("nav", [element("a", s.title, href=f"#{a}")
+                          for a, s in zip(anchors, sections, strict=True)])
     body = "\n".join(render_section(s, a) for s, a in zip(sections, anchors, strict=True))
     log = ""
     if log_lines:
-        log = ('<section id="log"><h2>Run log</h2><pre>' + html.escape("\n".join(log_lines))
-               + "</pre></section>")
-    return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
-            f"<title>{html.escape(title)}</title><style>{CSS}</style></head>\n<body>"
-            f"<header><h1>{html.escape(title)}</h1><p class=\"meta\">{html.escape(meta)}</p>"
-            f"<nav>{nav}</nav></header>\n{body}\n{log}\n</body></html>\n")
+        log = element("section", element("h2", "Run log"), element("pre", "\n".join(log_lines)),
+                      id="log")
+    head = element("head", Markup('<meta charset="utf-8">'),
+                   element("meta", name="viewport",
+                           content="width=device-width, initial-scale=1"),
+                   element("title", title), element("style", Markup(CSS)))
+    header = element("header", element("h1", title), element("p", meta, class_="meta"), nav)
+    return (f'<!DOCTYPE html>\n<html lang="en">{head}\n<body>{header}\n{body}\n{log}\n'
+            "</body></html>\n")
 
 
 def write_report(out_dir, title: str, meta: str, sections, log_lines=(),

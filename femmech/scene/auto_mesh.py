@@ -32,6 +32,8 @@ from femmech.errors import ModelWarning
 from femmech.fe import sizing
 from femmech.fe.generators import box, grid_frame, members_frame, rectangular_plate
 from femmech.fe.mesh import Mesh
+from femmech.scene.memory import memory_problem
+from femmech.scene.mesh import generator_counts
 
 MAX_ROUNDS = 4
 """Most sizing rounds (eigen solves) for a band given as ``n_modes``."""
@@ -59,6 +61,24 @@ def generate(kind: str, params: dict) -> Mesh:
         return box(params["length"], params["width"], params["height"], nx, ny, nz,
                    params["end_plates"], params["kind"])
     raise ValueError(f"unknown generator {kind!r}")
+
+
+def _fits(kind: str, params: dict, refined: bool = False) -> None:
+    """ValueError if the mesh of these counts (``refined``: with the divisions doubled,
+    the h/2 mesh of the shell check) would need more memory than this machine has
+    (:func:`femmech.scene.memory.memory_problem`); nothing is built."""
+    if refined:
+        params = {**params, "divisions": tuple(2 * n for n in params["divisions"])}
+    problem = memory_problem(**generator_counts(kind, params))
+    if problem is not None:
+        raise ValueError(problem + (" for the h/2 mesh of the shell check" if refined
+                                    else ""))
+
+
+def _built(kind: str, params: dict) -> Mesh:
+    """:func:`generate` after the memory check (:func:`_fits`)."""
+    _fits(kind, params)
+    return generate(kind, params)
 
 
 def sized_params(kind: str, params: dict, target_error: float, f_max: float, beams: dict,
@@ -116,10 +136,10 @@ def auto_mesh(spec, beams: dict, shells: dict, model_of) -> Mesh:
         else:
             params, f_max = _sized_for_modes(spec, int(value), beams, shells, model_of)
             if f_max is None:  # only rigid-body modes asked for: any mesh resolves them
-                return generate(spec.generator, params)
+                return _built(spec.generator, params)
         if spec.generator in _SHELL_SIDES:
             params = _checked(spec, params, f_max, model_of)
-        return generate(spec.generator, params)
+        return _built(spec.generator, params)
     except ValueError as exc:
         raise ValueError(f"mesh = 'auto' (target_error {spec.target_error:g}, band"
                          f" {kind} = {value:g}): {exc}; raise target_error or narrow the"
@@ -131,7 +151,7 @@ def _sized_for_modes(spec, n_modes: int, beams: dict, shells: dict, model_of):
     params = _coarse_params(spec.generator, spec.params)
     f = None
     for _ in range(MAX_ROUNDS):
-        f = float(modes(model_of(generate(spec.generator, params)),
+        f = float(modes(model_of(_built(spec.generator, params)),
                         n_modes=n_modes).freq_hz[-1])
         if not f > 0.0:
             return params, None
@@ -148,7 +168,8 @@ def _checked(spec, params: dict, f_max: float, model_of) -> dict:
     docstring); flagged (untrusted) estimates count as twice the target."""
     target = spec.target_error
     for attempt in range(MAX_CORRECTIONS + 1):
-        est = discretisation_error(model_of(generate(spec.generator, params)),
+        _fits(spec.generator, params, refined=True)
+        est = discretisation_error(model_of(_built(spec.generator, params)),
                                    band_hz=(0.0, f_max * (1 + 1e-9)))
         worst = est.max_error()
         if worst <= target:

@@ -52,6 +52,8 @@ from femmech.scene.auto_mesh import auto_mesh, generate
 from femmech.scene.chain import check_chain
 from femmech.scene.load import PartSpec, Scene, fail
 from femmech.scene.mechanisms import check_drive_event, confined_module, mechanism_model
+from femmech.scene.memory import memory_problem, mesh_counts
+from femmech.scene.mesh import generator_counts
 from femmech.version import __version__
 
 _ITEMS = {"support": Support, "mass": PointMass, "spring": Spring,
@@ -150,9 +152,15 @@ def part_mesh(scene: Scene, part: PartSpec) -> Mesh:
         if not isinstance(ref, str):  # node indices depend on the sized counts
             raise fail(scene, part.where, "mesh", f"with mesh = 'auto' give nodes by group"
                        f" name, not {np.ravel(ref).tolist()} ([{where}] {key})")
+    if spec.file is None and not spec.auto:  # counts given: checked before building
+        key = _COUNT_KEYS[spec.generator]
+        if spec.generator == "grid_frame" and spec.params["subdivisions"] == 1:
+            key = "bays"
+        _check_memory(scene, spec, generator_counts(spec.generator, spec.params), key)
     try:
         if spec.file is not None:
             mesh = read_mesh(spec.file)
+            _check_memory(scene, spec, mesh_counts(mesh), "mesh")
         elif spec.auto:  # mesh = "auto": counts sized for the part's band
             args = _model_args(scene, part)
             mesh = auto_mesh(spec, args["beams"], args["shells"] or {},
@@ -170,6 +178,22 @@ def part_mesh(scene: Scene, part: PartSpec) -> Mesh:
         key = "mesh" if spec.file is not None else None
         raise fail(scene, spec.where, key, str(exc)) from None
     return mesh if spec.merge_tol is None else merged_mesh(scene, part, mesh)
+
+
+_COUNT_KEYS = {"grid_frame": "subdivisions", "members": "members",
+               "rectangular_plate": "divisions", "box": "divisions"}
+
+
+def _check_memory(scene: Scene, spec, counts: dict, key: str) -> None:
+    """SceneError at ``[spec.where] key`` (one line: the estimate and the limit in GB) if
+    a part of these counts would need more memory than this machine has
+    (:mod:`femmech.scene.memory`)."""
+    try:
+        problem = memory_problem(**counts)
+    except ValueError as exc:  # a bad $FEMMECH_MEMORY_LIMIT_GB
+        raise fail(scene, spec.where, key, str(exc)) from None
+    if problem is not None:
+        raise fail(scene, spec.where, key, problem)
 
 
 def merged_mesh(scene: Scene, part: PartSpec, mesh: Mesh) -> Mesh:

@@ -21,8 +21,13 @@ from pathlib import Path
 
 from femmech.errors import SceneError
 from femmech.fe.checks import NEAR_NODE_TOL
-from femmech.fe.generators import MAX_ELEMENTS_PER_MEMBER, grid_frame_size
-from femmech.fe.mesh import MAX_CELLS, MAX_NODES
+from femmech.fe.generators import (
+    MAX_ELEMENTS_PER_MEMBER,
+    box_size,
+    grid_frame_size,
+    rectangular_plate_size,
+)
+from femmech.fe.mesh import MAX_CELLS, MAX_NODES, NODES_PER_CELL
 from femmech.scene.reader import Reader, one_line, show
 from femmech.scene.units import FREQUENCY, LENGTH
 
@@ -144,8 +149,8 @@ def _plate(g: Reader) -> dict:
     params["kind"] = g.string("element", "quad", choices=SHELL_GENERATOR_ELEMENTS)
     params["divisions"] = _shell_divisions(g, 2, "[nx, ny]")
     if params["divisions"] is not None:
-        nx, ny = params["divisions"]
-        _check_counts(g, "divisions", (nx + 1) * (ny + 1), 2 * nx * ny)
+        _check_counts(g, "divisions", *rectangular_plate_size(*params["divisions"],
+                                                              params["kind"]))
     return params
 
 
@@ -156,9 +161,8 @@ def _box(g: Reader) -> dict:
     params["end_plates"] = g.boolean("end_plates", True)
     params["divisions"] = _shell_divisions(g, 3, "[nx, ny, nz]")
     if params["divisions"] is not None:
-        nx, ny, nz = params["divisions"]
-        _check_counts(g, "divisions", 2 * (nx + 1) * (ny + nz) + 2 * (ny + 1) * (nz + 1),
-                      4 * (nx * (ny + nz) + ny * nz))
+        _check_counts(g, "divisions", *box_size(*params["divisions"], params["end_plates"],
+                                                params["kind"]))
     return params
 
 
@@ -178,6 +182,32 @@ def _grid_frame(g: Reader) -> dict:
     _check_counts(g, "bays", *grid_frame_size(bays))
     _check_counts(g, "subdivisions", *grid_frame_size(bays, params["subdivisions"]))
     return params
+
+
+def generator_counts(kind: str, params: dict) -> dict:
+    """What a generator with its counts would make, for
+    :func:`femmech.scene.memory.memory_problem` (keyword arguments: ``n_nodes``, ``cells``
+    (nodes per cell → cells), ``dimension``, ``n_joints``), computed without building it."""
+    if kind == "grid_frame":
+        n_nodes, n_cells = grid_frame_size(params["bays"], params["subdivisions"])
+        dimension = max(1, sum(b > 0 for b in params["bays"]))
+        return {"n_nodes": n_nodes, "cells": {2: n_cells}, "dimension": dimension,
+                "n_joints": grid_frame_size(params["bays"])[0]}
+    if kind == "members":
+        n_cells = n_segments = 0
+        for m in params["members"]:
+            chain = list(m["chain"])
+            for a, b in zip(chain[:-1], chain[1:], strict=True):
+                length = math.dist(params["joints"][a], params["joints"][b])
+                k = m.get("divisions") or length / m["element_size"]
+                n_cells, n_segments = n_cells + max(1, round(k)), n_segments + 1
+        return {"n_nodes": len(params["joints"]) + n_cells - n_segments,
+                "cells": {2: n_cells}, "dimension": 1, "n_joints": None}
+    size = rectangular_plate_size if kind == "rectangular_plate" else box_size
+    extra = () if kind == "rectangular_plate" else (params["end_plates"],)
+    n_nodes, n_cells = size(*params["divisions"], *extra, params["kind"])
+    return {"n_nodes": n_nodes, "cells": {NODES_PER_CELL[params["kind"]]: n_cells},
+            "dimension": 2, "n_joints": None}
 
 
 def _check_counts(r: Reader, key: str, n_nodes: int, n_elements: int) -> None:
