@@ -104,7 +104,7 @@ class SweepSpec:
     """Quasi-modes over drive angles (rad) at one or more drive speeds (rad/s)."""
 
     angles: tuple
-    n_modes: int
+    n_modes: int | None  # None: up to 6, all branches where fewer exist (said in the report)
     speeds: tuple
     mechanism: str | None
     track: bool
@@ -333,7 +333,7 @@ def _sweep(t: Reader, parts, mechanisms, has_mounts) -> SweepSpec:
     if at and (mechanism is not None or len(parts) != 1):
         raise t.error("mode_images_at", "mode images need a machine of one part (not a"
                                         " mechanism alone, not an assembly of parts)")
-    n_modes = _n_modes(t, 6)
+    n_modes = _n_modes(t)  # None: sweep's default (6, or all branches where fewer exist)
     speeds = _values(t, "speeds", SPEED, (0.0,))
     if len(angles) * len(speeds) > MAX_SWEEP_POINTS:
         raise t.error("speeds", f"{len(angles)} angles x {len(speeds)} speeds; at most"

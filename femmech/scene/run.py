@@ -127,7 +127,8 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
 
     cache = default_cache_dir() if cache_dir is DEFAULT else cache_dir
     start = time.perf_counter()
-    prepared = prepare(scene, allow_code=allow_code, code_root=code_root)
+    with logged_warnings(emit, "prepare"):  # e.g. what a mesh file loses (read_mesh)
+        prepared = prepare(scene, allow_code=allow_code, code_root=code_root)
     with staged_output(out) as stage:
         final = output_path(out)
         ws = Workshop(prepared, cache, emit, bars)

@@ -180,16 +180,22 @@ def _index_cell(confirmed):
 def run_sweep(ws, spec, out):
     """Quasi-eigenfrequencies over the drive angle, per speed."""
     phi = np.asarray(spec.angles, dtype=float)
-    unit, curves = spec.speed_unit, {}
+    unit, curves, notes = spec.speed_unit, {}, []
     for W in spec.speeds:
         label = format_speed(W, unit)
         with ws.timed("sweep"):
             if spec.mechanism is not None:
                 q = quasi_modes(ws.prepared.mechanisms[spec.mechanism], phi, Omega=W)
-                curves[label] = _Curve(q.phi, q.freq_hz[:, :spec.n_modes])
+                n_default = min(6, q.freq_hz.shape[1])
+                curves[label] = _Curve(q.phi, q.freq_hz[:, :spec.n_modes or n_default])
+                if spec.n_modes is None and q.freq_hz.shape[1] < 6:
+                    notes.append(f"n_modes not given: the mechanism has"
+                                 f" {q.freq_hz.shape[1]} branches, fewer than the default 6;"
+                                 " all are shown")
             else:
                 s = sweep(ws.machine(), phi, Omega=W, n_modes=spec.n_modes, track=spec.track)
                 curves[label] = _Curve(s.phi, s.freq_hz)
+                notes.extend(s.notes)
     what = f"mechanism {spec.mechanism!r} alone" if spec.mechanism else "coupled machine"
     plot_quasi_frequencies(curves, out / "quasi_frequencies.png",
                            title=f"{ws.scene.name}: {what}", speed_unit=unit)
@@ -206,7 +212,8 @@ def run_sweep(ws, spec, out):
     for angle in spec.mode_images_at:
         figures.append(_coupled_image(ws, spec, angle, out))
     text = (f"{phi.size} drive angles from {np.rad2deg(phi[0]):.1f}° to"
-            f" {np.rad2deg(phi[-1]):.1f}°, {n} branches, speeds {', '.join(curves)}.",)
+            f" {np.rad2deg(phi[-1]):.1f}°, {n} branches, speeds {', '.join(curves)}.",
+            *(f"{note}." for note in dict.fromkeys(notes)))
     section = Section("Quasi-eigenfrequencies over the drive angle", text,
                       (Table("Range of each branch over the sweep", ("speed", "branch",
                                                                     "min (Hz)", "max (Hz)"),
