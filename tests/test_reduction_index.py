@@ -169,6 +169,13 @@ def test_the_scene_marks_unconfirmed_modes(plate, tmp_path):
     assert "reduced mode(s) marked unconfirmed" in html
     assert "index unconfirmed for mode(s)" in html
     assert "mode(s) 6, 10 (Sturm" in html  # the flags of the test above
+    # the CSV a user post-processes carries the same flags (1: confirmed, 0: unconfirmed)
+    import csv
+
+    with open(tmp_path / "out" / "frequencies.csv", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    unconfirmed = [int(r["mode"]) for r in rows if r["index_confirmed"] == "0"]
+    assert unconfirmed == [6, 10]
 
 
 def test_one_count_above_all_decides_when_nothing_is_missed():

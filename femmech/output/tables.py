@@ -54,7 +54,9 @@ def write_frequency_csv(modes: ModeSet, filename) -> Path:
     """Write the frequency table as CSV, atomically.
 
     Columns ``mode`` (from 1), ``freq_hz`` (Hz, full precision), ``rigid`` (0/1) and
-    ``residual`` (relative residual of the eigenpair).
+    ``residual`` (relative residual of the eigenpair); modes of a superelement whose index
+    the full model's Sturm count checked (:attr:`ModeSet.index_confirmed`) add
+    ``index_confirmed`` (1: the full mode of the same number, 0: unconfirmed).
 
     Parameters
     ----------
@@ -69,10 +71,12 @@ def write_frequency_csv(modes: ModeSet, filename) -> Path:
     """
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(_HEADER)
+    confirmed = modes.index_confirmed
+    writer.writerow(_HEADER + ("index_confirmed",) * (confirmed is not None))
     for i in range(modes.n_modes):
         writer.writerow([i + 1, repr(float(modes.freq_hz[i])), int(modes.rigid[i]),
-                         repr(float(modes.residual[i]))])
+                         repr(float(modes.residual[i]))]
+                        + ([int(confirmed[i])] if confirmed is not None else []))
     with atomic_path(filename) as tmp:
         tmp.write_text(buffer.getvalue(), encoding="utf-8")
     return Path(filename)

@@ -432,10 +432,12 @@ def run_check(ws, spec, out):
     with atomic_path(out / "reduced_vs_full.txt") as tmp:
         tmp.write_text(comp.table() + "\n", encoding="utf-8")
     k = np.arange(spec.n_modes)
+    matches = matched_full_modes(comp)
     _write_csv(out / "reduced_vs_full.csv", ["angle_deg", "mode", "full_hz", "reduced_hz",
-                                             "rel_error", "mac"],
+                                             "rel_error", "mac", "matches_full_mode"],
                [(float(np.rad2deg(a)), int(j + 1), comp.freq_full_hz[i, j],
-                 comp.freq_reduced_hz[i, j], comp.rel_error[i, j], comp.diag_mac[i, j])
+                 comp.freq_reduced_hz[i, j], comp.rel_error[i, j], comp.diag_mac[i, j],
+                 int(matches[i, j] + 1))
                 for i, a in enumerate(comp.phi) for j in k])
     plot_mac(comp.mac[0], out / "mac_reduced_vs_full.png", "reduced coupled modes",
              "full coupled modes", f"MAC at φ = {np.rad2deg(comp.phi[0]):.0f}°")
@@ -450,7 +452,6 @@ def run_check(ws, spec, out):
         e, m = float(np.abs(c.rel_error).max()), float(c.diag_mac.min())
         rows.append((f"f_max {f_max:g} Hz", system.n, 1e3 * c.seconds_reduced, e, m))
         levels.append({"f_max_hz": f_max, "n": system.n, "max_rel_error": e, "min_mac": m})
-    matches = matched_full_modes(comp)
     tables = [Table("Reduced versus full at the check angles", ("angle (°)", "mode",
                                                                "full (Hz)", "reduced (Hz)",
                                                                "rel. error", "MAC",
