@@ -1,5 +1,5 @@
-"""Smoke test of the issue-10 benchmark suite (benchmarks/run.py --suite issue10) at size
-tiny: no timing assertions. The peer suite (issue 24) is tests/test_benchmarks_peers.py."""
+"""Smoke test of the older benchmark suite (benchmarks/run.py --suite issue10) at size
+tiny: no timing assertions. The peer suite is tests/test_benchmarks_peers.py."""
 
 import importlib.util
 import math
@@ -90,7 +90,7 @@ def test_rows_describe_the_models_and_agree_where_they_must(suite, tiny):
     for i in ("8 joints", "rails"):
         assert by[(i, "CB+RV")]["err20"] <= by[(i, "CB")]["err20"]
     sweep = results["reduced_sweep"].rows
-    assert all(r["n_reduced"] <= 100 for r in sweep)  # the r <= 100 of issue 10
+    assert all(r["n_reduced"] <= 100 for r in sweep)  # the suite's target r <= 100
     assert sorted({r["n_angles"] for r in sweep}) == [36, 360]
     (coupled,) = results["coupled"].rows
     # reduced vs full coupled textile shaft, 6 lowest modes: the Craig-Bampton + residual

@@ -1,4 +1,4 @@
-"""Smoke test of the peer suite (benchmarks/run.py, issue 24) at size tiny, one repeat.
+"""Smoke test of the peer suite (benchmarks/run.py) at size tiny, one repeat.
 
 No timing assertions: the tables must run, carry the header, and their error columns must
 show that femmech and the peer solved the same problem.

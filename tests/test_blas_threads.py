@@ -1,4 +1,4 @@
-"""The BLAS thread counts the tests run with (issue 18, tests/conftest.py).
+"""The BLAS thread counts the tests run with (tests/conftest.py).
 
 ``.ci/run`` runs the suite on all cores, then with ``FEMMECH_TEST_BLAS_THREADS=1`` and
 ``=2``, so that round-off is summed in other orders. This checks, inside the run, that the

@@ -1,6 +1,6 @@
 """Reduction cache of scene runs: reuse, invalidation of exactly the affected entries,
-detection of corrupted entries (issue 8); a cache that never breaks a run: unreadable,
-unwritable, full, corrupt or foreign, shared by processes, size-limited (issue 19).
+detection of corrupted entries; a cache that never breaks a run: unreadable,
+unwritable, full, corrupt or foreign, shared by processes, size-limited.
 Asserted through the run log and the warnings, never timing."""
 
 import errno
@@ -294,7 +294,7 @@ def test_interrupted_write_leaves_no_trusted_entry(tmp_path, superelement, monke
     assert isinstance(Superelement.load(entry_paths(tmp_path, "b" * 64)[0]), Superelement)
 
 
-# --- a cache that never breaks a run (issue 19) ---------------------------------------------
+# --- a cache that never breaks a run ---------------------------------------------
 
 KEY = "d" * 64
 

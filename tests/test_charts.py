@@ -1,4 +1,4 @@
-"""Charts that read at a glance (issue 20, item 3): the greedy label placement on boxes,
+"""Charts that read at a glance: the greedy label placement on boxes,
 axis scales and angle ticks, the quasi-eigenfrequency diagram read back from its
 artists, time histories, and one speed unit per scene (the ``[analyses] speed_unit`` key,
 the sweep and stability tasks' CSV headers, labels and report tables)."""

@@ -1,4 +1,4 @@
-"""A-posteriori error estimate of coupled quasi-eigenfrequencies (issue 24, target 6).
+"""A-posteriori error estimate of coupled quasi-eigenfrequencies.
 
 :func:`femmech.reduction.estimate.coupled_error_estimates` on the textile main shaft of
 examples/textile_shaft.py with 4 cams. References, independent of the estimate: the

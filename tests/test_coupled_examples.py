@@ -1,4 +1,4 @@
-"""Coupled-machine examples of issue 6: processing machine (a) and press in a C-frame (c).
+"""Coupled-machine examples: processing machine (a) and press in a C-frame (c).
 
 Each example is checked against (1) the mechanism-only quasi-eigenfrequencies of the
 mechanism issue with a rigid frame and (2) its unreduced coupled model at several angles.
@@ -137,7 +137,7 @@ def test_processing_machine_rigid_frame_reproduces_chapter(machine):
 
 
 def test_processing_machine_reduced_matches_full(machine_run):
-    # Issue 6 acceptance at 5 angles (dwell, rises, returns), the 9 modes below 450 Hz
+    # Acceptance at 5 angles (dwell, rises, returns), the 9 modes below 450 Hz
     # (follower, frame and shaft-torsion branches). The largest error is the shaft's
     # first torsion branch (~310 Hz): the interior torsional inertia of the shaft is
     # carried only by residual vectors, whose error is of order (f / f_t)⁴ = 1.6e-5 with
@@ -181,7 +181,7 @@ def press_run(press, tmp_path_factory):
 
 
 def test_press_reduced_matches_full(press_run):
-    # Issue 6 acceptance at 7 angles incl. BDC (0°), near BDC (2°) and TDC (180°), the
+    # Acceptance at 7 angles incl. BDC (0°), near BDC (2°) and TDC (180°), the
     # 8 modes below 420 Hz. Measured: max frequency error 2.7e-7 (the ram branch at
     # ~400 Hz; 1.0e-9 with f_max doubled, so it is the reduction's truncation), MAC
     # 1 - 1.0e-8. Tolerances 1e-6 and MAC > 1 - 1e-6, far inside 0.5 % and 0.95.

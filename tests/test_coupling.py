@@ -1,4 +1,4 @@
-"""Frame-mechanism coupling and quasi-mode sweeps (issue 6 core)."""
+"""Frame-mechanism coupling and quasi-mode sweeps (core)."""
 
 import numpy as np
 import pytest
@@ -66,7 +66,7 @@ def cam_model():
 def test_rigidly_held_guide_reproduces_mechanism_alone(cam_model):
     # Guide attached at a supported node (uy fixed): y_g = 0 exactly, so the coupled
     # spectrum is the union of the frame's and the mechanism-alone quasi-frequencies
-    # (issue 5's quasi_modes on Table 5.1 case 1); dense LAPACK on both: round-off.
+    # (quasi_modes on Table 5.1 case 1); dense LAPACK on both: round-off.
     fe = _beam()
     se = craig_bampton(fe, "mid", n_modes=10)
     system = couple(se, [Mount(cam_model, (Attachment("y_g", 0, "uy"),), name="cam")])

@@ -1,4 +1,4 @@
-"""The discretisation-error estimate per mode (issue 22, item 2) against true errors.
+"""The discretisation-error estimate per mode against true errors.
 
 The estimate (one h/2 refinement, Richardson with the family's rate,
 :mod:`femmech.analysis.discretisation`) must lie within a factor 3 of the true relative
@@ -20,7 +20,7 @@ from femmech.fe.refine import refined_model
 from femmech.fe.sections import rectangle
 
 STEEL = fm.Material(E=200e9, nu=0.3, rho=8000.0)
-FACTOR = 3.0  # the acceptance of issue 22: estimate within a factor 3 of the truth
+FACTOR = 3.0  # the acceptance: estimate within a factor 3 of the truth
 
 
 def within_factor(est, truth, trusted):

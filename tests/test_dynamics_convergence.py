@@ -1,4 +1,4 @@
-"""No silent wrong numbers in periodic dynamics (issue 18, deliverable 2).
+"""No silent wrong numbers in periodic dynamics.
 
 Fixed step counts gave Floquet multipliers and periodic steady states that were wrong at
 low drive speed without a word (the press example at 10 rpm: spectral radius NaN at
@@ -55,7 +55,7 @@ OFFSET_CAM = CamProfile(CAM.segments, phi_start=0.3)  # joints off any uniform g
 
 def test_expm_stack_matches_scipy():
     # Scaling and squaring with the degree-18 Taylor polynomial (Bader, Blanes & Casas
-    # 2019; Higham's [13/13] Padé before issue 24) has backward error below the unit
+    # 2019; Higham's [13/13] Padé of the earlier integrator) has backward error below the unit
     # round-off; against scipy's Padé (matrix by matrix, other rounding) the forward
     # difference is bounded by the condition of the exponential, at most about ‖A‖₁
     # times eps relative to |e^A|: 50 eps max(1, ‖A‖₁) (measured at most 0.03 of it

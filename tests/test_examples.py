@@ -99,7 +99,7 @@ def test_frame_example_writes_outputs(frame_run):
 
 
 def test_textile_shaft_reduced_matches_full(tmp_path):
-    # Issue 6 acceptance: reduced coupled vs full coupled at 4 angles (dwell, rise,
+    # Acceptance: reduced coupled vs full coupled at 4 angles (dwell, rise,
     # peak, return). Craig-Bampton with residual vectors resolves the frame/shaft modes
     # in the band to ~1e-8 (measured 1.3e-8 and MAC 1 - 1e-12), so the test demands
     # 1e-6 and MAC > 0.9999, far tighter than the issue's 0.5 % / 0.95.
@@ -125,7 +125,7 @@ def test_textile_shaft_reduced_matches_full(tmp_path):
 
 @pytest.mark.slow
 def test_knitting_machine_chain_example(tmp_path):
-    # Issue 21 acceptance example (numbers checked in tests/test_scene_chain.py): it runs
+    # Acceptance example (numbers checked in tests/test_scene_chain.py): it runs
     # from the command line's main() and writes its three charts
     result = _load("knitting_machine_chain").main(tmp_path, n_angles=13, starts=1)
     # bound: transfer roots to 1e-12 relative against eigh's eps λ_max/λ (roundoff.py)

@@ -1,4 +1,4 @@
-"""Force recovery from time histories: attachment and drive forces (issue 7 item 4)."""
+"""Force recovery from time histories: attachment and drive forces."""
 
 import numpy as np
 import pytest

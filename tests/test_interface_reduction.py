@@ -1,4 +1,4 @@
-"""Craig-Bampton with a reduced interface (femmech.reduction.interface_modes, issue 24 target 3).
+"""Craig-Bampton with a reduced interface (femmech.reduction.interface_modes).
 
 Reference: plain Craig-Bampton with residual vectors on the whole interface (the
 "unreduced-interface model" of the issue), reduced with the same fixed-interface modes.

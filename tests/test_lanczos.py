@@ -1,5 +1,5 @@
 """Block Lanczos with partial reorthogonalisation, ordering reuse of the Sturm check and
-chunked shell element batches (issue 10, item 1 and 3).
+chunked shell element batches.
 
 References: dense LAPACK on the same pencil (:func:`femmech.solve.dense.dense_symmetric`,
 shift-inverted, relative accuracy ~eps for the lowest modes), ARPACK (``_arpack``) and a
@@ -8,7 +8,7 @@ backward-stable solve are exact for a pencil perturbed by ~eps ‖K‖, so they 
 error ~eps λ_max (``roundoff.eigenvalue_atol``), which is the whole difference between two
 such solvers; the relative error eps λ_max / λ_k is largest for the lowest modes (3e-8 for
 the tube's first pair, 8e-12 for the frame's first mode). How far below that bound a
-result lands depends on the BLAS kernel's summation order (issue 18: 4e-14 on one
+result lands depends on the BLAS kernel's summation order (4e-14 on one
 machine, 2e-12 on another), so no tolerance here is tighter than the bound.
 """
 

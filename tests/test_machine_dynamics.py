@@ -1,4 +1,4 @@
-"""Issue 7 acceptance on the machines: power balance of the drive force, coupled Floquet
+"""Acceptance on the machines: power balance of the drive force, coupled Floquet
 multipliers against direct integration, the Ritz-basis monodromy, support reactions and
 the steady-state / stability sections of the coupled-machine examples."""
 

@@ -1,8 +1,8 @@
-"""The kernels of the monodromy integrator (issue 24, target 5): the degree-18 Taylor
+"""The kernels of the monodromy integrator: the degree-18 Taylor
 exponential, the balancing of the step exponentials, the block commutator and the batched
 doubling levels, each against an independent computation.
 
-The integrator before issue 24 (Higham's [13/13] Padé exponential of the unbalanced
+The earlier integrator (Higham's [13/13] Padé exponential of the unbalanced
 step exponents, one level at a time) is rebuilt here from scipy.linalg.expm (the same
 Padé algorithm) as :func:`_reference_magnus`, so that "agrees with the old integrator"
 is checked against code that does not share the new kernels.
@@ -38,7 +38,7 @@ def _stiff_hill():
 
 def _reference_magnus(M, B, C, T, n):
     """Magnus-4 over n equal steps with scipy.linalg.expm of each unbalanced step exponent
-    (the integrator before issue 24, matrix by matrix)."""
+    (the earlier integrator, matrix by matrix)."""
     h = T / n
     t = (np.arange(n)[:, None] * h + magnus.GAUSS_OFFSETS[None, :] * h).ravel()
     Bs = np.broadcast_to(B, (t.size, *np.shape(B)))
@@ -122,7 +122,7 @@ def test_round_off_floor_on_a_stiff_system_against_an_exact_exponential():
     # 1024 steps over 0.2 s): Magnus is exact, so only round-off of 1024 step
     # exponentials and their product remains. Reference: exp(A T) in 40-digit arithmetic
     # (mpmath). Measured ρ error 1.1e-12 (old integrator 7.8e-14; on the press example
-    # the old one's floor was 1e-9 and the new one's 4e-13, docs of issue 24): required
+    # the old one's floor was 1e-9 and the new one's 4e-13, docs/performance.md): required
     # 1e-11, 7 orders below the default tolerance 1e-4.
     import mpmath
 

@@ -1,4 +1,4 @@
-"""The meshes users already have (issue 20, item 5): node and element sets of Abaqus decks,
+"""The meshes users already have: node and element sets of Abaqus decks,
 Nastran bulk data, VTU and MED files as node and cell sets; names that do not exist listed
 with a "did you mean"; interfaces on solid nodes; the x-z orientation convention.
 

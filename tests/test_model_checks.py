@@ -1,4 +1,4 @@
-"""Model checks (issue 18): inputs that give wrong numbers without an error are reported.
+"""Model checks: inputs that give wrong numbers without an error are reported.
 
 Nearly coincident nodes that split a frame, pieces that are free bodies by accident and
 unit mix-ups give a ModelWarning from build_model and fm.modes, naming nodes, distances

@@ -274,7 +274,7 @@ def test_cantilever_image_matches_reference(tmp_path):
         reference.write_bytes(out.read_bytes())
     error = pv.compare_images(str(out), str(reference), use_vtk=False)
     # Mean over pixels of the summed |ΔRGB| (0..765), measured against this reference
-    # (issue 20 layout: header, panel and triad around the view): a 1 % camera zoom 6.1,
+    # (report layout: header, panel and triad around the view): a 1 % camera zoom 6.1,
     # a 3 % larger displacement scale 7.8 (the size of shading and edge differences
     # between OpenGL drivers or VTK versions is below these); the bar deflecting the
     # other way 12.6, the second (stiff-plane) bending mode 11.6; re-rendering 0.0. The
@@ -348,7 +348,7 @@ def test_frequency_table_and_csv(tmp_path):
     assert_allclose([float(r["residual"]) for r in rows], result.residual, rtol=0)
 
 
-# -- issue 20: one scene per model, one camera, annotations ---------------------------------
+# -- one scene per model, one camera, annotations ---------------------------------
 
 
 def _decorated_frame():

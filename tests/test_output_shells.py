@@ -247,7 +247,7 @@ def test_plate_image_matches_reference(tmp_path):
         reference.write_bytes(out.read_bytes())
     error = pv.compare_images(str(out), str(reference), use_vtk=False)
     # Mean over pixels of the summed |ΔRGB| (0..765), measured against this reference
-    # (issue 20 layout): a 1 % camera zoom 28.6 and a 3 % larger displacement scale 35.4
+    # (report layout): a 1 % camera zoom 28.6 and a 3 % larger displacement scale 35.4
     # (every element edge line moves), the plate deflecting the other way 46.0, the
     # second mode 45.2, the plate meshed with quads 28.8; re-rendering gives 0.0 on the
     # same machine. The threshold 20 lets line-rasterisation and antialiasing differences

@@ -1,4 +1,4 @@
-"""Substructure reduction (issue 3): Guyan and Craig-Bampton superelements.
+"""Substructure reduction: Guyan and Craig-Bampton superelements.
 
 References are independent of :mod:`femmech.reduction`: the full model solved directly
 (sparse static solve of ``K_free``, dense ``scipy.linalg.eigh`` of ``K_free, M_free`` on

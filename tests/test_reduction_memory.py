@@ -1,4 +1,4 @@
-"""Craig-Bampton's low-memory order (issue 24, item 6): on large models the Sturm check of
+"""Craig-Bampton's low-memory order: on large models the Sturm check of
 the fixed-interface modes runs after the K_ii factorisation is freed. The order must not
 change the superelement, and a failed count must fall back to the full path."""
 

@@ -1,7 +1,6 @@
 """HTML report of a scene run: self-contained page, atomic writes, and a real headless
-browser (Debian's Chromium) that loads the page and its images (issue 8); the model
-summary, mass participation and appendix a reviewer signs, with formatted numbers
-(issue 20)."""
+browser (Debian's Chromium) that loads the page and its images; the model
+summary, mass participation and appendix a reviewer signs, with formatted numbers."""
 
 import os
 import re
@@ -189,7 +188,7 @@ def test_report_opens_in_headless_chromium_and_images_load(report_run, tmp_path)
     _browser_check(report_run.out_dir, report_run.report.read_text(), tmp_path)
 
 
-# --- the report a reviewer signs (issue 20) ---------------------------------------------
+# --- the report a reviewer signs ---------------------------------------------
 
 RAW_FLOAT = re.compile(r"\d*\.?\d+")
 

@@ -1,4 +1,4 @@
-"""Forced response of rheolinear systems: generalised-α, shooting, frame recovery (issue 7)."""
+"""Forced response of rheolinear systems: generalised-α, shooting, frame recovery."""
 
 import numpy as np
 import pytest

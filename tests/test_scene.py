@@ -1,5 +1,5 @@
 """Scene files: validation with one-line errors naming the location, units, and the
-mapping of scenes onto the Python API (issue 8)."""
+mapping of scenes onto the Python API."""
 
 import importlib.util
 import tomllib

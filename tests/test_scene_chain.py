@@ -253,7 +253,7 @@ def test_example_scene_matches_the_example_script():
 
 @pytest.mark.slow
 def test_knitting_machine_example(tmp_path):
-    """Acceptance of issue 21: the φ-sweep by three methods, the Campbell diagram and a
+    """Acceptance of the chain scenes: the φ-sweep by three methods, the Campbell diagram and a
     synthesis that moves every quasi-eigenfrequency out of the harmonic bands (about a
     minute on one core)."""
     r = _example().main(tmp_path, n_angles=37, starts=2)

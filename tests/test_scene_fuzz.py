@@ -1,4 +1,4 @@
-"""Scene fuzzing (issue 19): any corruption of a scene is valid or one clean line.
+"""Scene fuzzing: any corruption of a scene is valid or one clean line.
 
 The oracle: reading a scene and :func:`femmech.scene.build.prepare` (what ``femmech
 check`` runs) either succeed or raise an :class:`~femmech.errors.InputError` (a

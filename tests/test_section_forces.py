@@ -1,4 +1,4 @@
-"""Section forces of beam elements recovered from coupled responses (issue 7 item 4)."""
+"""Section forces of beam elements recovered from coupled responses."""
 
 import numpy as np
 import pytest

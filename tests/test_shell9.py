@@ -281,7 +281,7 @@ def test_clamped_thin_plate_against_kirchhoff_ritz():
 
 
 def test_thin_plate_first_ten_frequencies_within_0p1_percent_on_16x16():
-    # the goal of issue 22; closed form ω_mn = π² (m²/a² + n²/b²) sqrt(D/ρt) (Leissa 1969)
+    # the accuracy goal; closed form ω_mn = π² (m²/a² + n²/b²) sqrt(D/ρt) (Leissa 1969)
     # with the Mindlin correction (3.1e-5 for mode 10 at a/t = 1000); measured max error 6.8e-4
     t = 1e-3
     lam = ssss_plate(16, t, modes=10)

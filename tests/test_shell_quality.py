@@ -1,4 +1,4 @@
-"""Shell quality checks at run time (issue 22, item 4).
+"""Shell quality checks at run time.
 
 Drilling cluster: a thick plate (t/a = 0.2) whose nodes rotate freely about the normal has
 a cluster of spurious drilling modes near ``sqrt(12 drilling G / ρ) / (2π t)`` (884 Hz for

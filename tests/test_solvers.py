@@ -1,4 +1,4 @@
-"""Sparse direct solver layer, thread control and AMG-preconditioned LOBPCG (issue 10).
+"""Sparse direct solver layer, thread control and AMG-preconditioned LOBPCG.
 
 Every installed backend is compared with SuperLU (always tested) and with independent
 references: dense LAPACK (``numpy.linalg.solve``, ``eigvalsh``, ``slogdet``) on the same

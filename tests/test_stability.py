@@ -1,4 +1,4 @@
-"""Floquet stability of periodic systems (issue 7, first part).
+"""Floquet stability of periodic systems (first part).
 
 Mathieu's equation in the form of Abramowitz & Stegun ch. 20 (eq. 20.1.1),
 

@@ -1,4 +1,4 @@
-"""Design studies on executors (issue 10, item 4): process pool, any executor, Dask.
+"""Design studies on executors: process pool, any executor, Dask.
 
 The reference of every parallel result is the serial evaluation of the same function in
 this process: jobs are independent, so the arrays must be equal exactly (not to a

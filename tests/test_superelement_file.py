@@ -1,4 +1,4 @@
-"""Superelement files (issue 19): validated loading, checksums, and a short fuzz run.
+"""Superelement files: validated loading, checksums, and a short fuzz run.
 
 Every damaged, foreign or crafted file must raise FileFormatError with one line that
 starts with the file name and names the field; a valid file must load identical to what

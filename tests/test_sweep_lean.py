@@ -1,5 +1,5 @@
 """The lean batched path of the coupled sweep (femmech.analysis.sweep._lean_loop) against
-the general per-angle path (_sweep_loop), which every sweep took before issue 24."""
+the general per-angle path (_sweep_loop), which every sweep took before the lean path."""
 
 import numpy as np
 import pytest

@@ -26,7 +26,7 @@ Why this scheme rather than explicit RK4 or an adaptive solver:
   at once (:func:`expm_stack`, batched scaling and squaring) and multiplied in a
   balanced tree, so the per-step Python cost is nil.
 
-Cost per step (issue 24; the press example, 2n = 50, measured 2.8 to 3.2 times faster
+Cost per step (the press example, 2n = 50, measured 2.8 to 3.2 times faster
 than before, same step counts): the step exponents are formed in *balanced* coordinates
 D⁻¹ A D (:func:`_balancing`, powers of 2, exact): ‖hA‖₁ of a stiff frame is ~ω_max² h
 against eigenvalues ~ω_max h, 1e6 against 18 on the press, and the balancing cuts the

@@ -58,9 +58,9 @@ benchmarks/solvers.py)."""
 
 AUTO_MIN_SIZE = 20_000
 """``"auto"`` uses CHOLMOD (where installed, else SuperLU) below this many unknowns.
-Issue 24 (benchmarks/peer_eigensolve.py, 5 472-DOF frame, shift factorisation + solve):
+Peer suite (benchmarks/peer_eigensolve.py, 5 472-DOF frame, shift factorisation + solve):
 CHOLMOD 2.1 ms + 0.05 ms per solve, SuperLU 4.3 ms + 0.26 ms, PARDISO 120 ms + 0.11 ms.
-Before (issue 10): Factorisation + 55 solves of grid
+Before: Factorisation + 55 solves of grid
 frames (this 2-core machine under load): 1 080 DOFs: SuperLU 14 ms, CHOLMOD 13 ms,
 PARDISO 125 ms; 3 744 DOFs: 84, 40, 436 ms; 13 200 DOFs: 0.42, 0.45, 0.67 s; 23 760
 DOFs: 1.2, 1.1, 1.3 s (benchmarks/solvers.py). MKL's thread start-up dominates small

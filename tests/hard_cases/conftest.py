@@ -1,4 +1,4 @@
-"""Hard-case tests (issue 9): one BLAS thread per module."""
+"""Hard-case tests: one BLAS thread per module."""
 
 import os
 

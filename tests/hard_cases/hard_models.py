@@ -1,4 +1,4 @@
-"""Small models and checks shared by the hard-case tests (issue 9).
+"""Small models and checks shared by the hard-case tests.
 
 Imported as a top-level module (pytest's rootdir-relative ``prepend`` import mode puts
 this folder on ``sys.path``), like the helpers of ``tests/``.

@@ -1,11 +1,11 @@
-"""Hard case 10: bad input (issue 9), property-based with hypothesis.
+"""Hard case 10: bad input, property-based with hypothesis.
 
 Random corruptions of a valid model (meshes with beams, shells and solids; materials;
 sections; lumped items; build_model arguments) must give a ValueError or TypeError that
 names the offending item, raised by femmech's own checks, never a traceback from deep
 inside numpy or scipy and never a silently wrong model.
 
-Mesh files are untrusted input too (issue 19): a damaged or oversized file gives a
+Mesh files are untrusted input too: a damaged or oversized file gives a
 ValueError naming the file. Scene files are fuzzed in tests/test_scene_fuzz.py (and at
 length by benchmarks/fuzz_scenes.py).
 """

@@ -1,4 +1,4 @@
-"""Hard case 3: repeated and clustered eigenvalues (issue 9).
+"""Hard case 3: repeated and clustered eigenvalues.
 
 A doubly symmetric frame (square plan, square tubes: pairs of equal frequencies by
 symmetry) and a shaft carrying N = 50 identical cam mechanisms (in the cams' dwell the

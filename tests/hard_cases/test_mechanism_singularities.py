@@ -1,4 +1,4 @@
-"""Hard case 5: mechanism singularities (issue 9).
+"""Hard case 5: mechanism singularities.
 
 Dead centres of a slider-crank (U' = 0) and a four-bar near its toggle position
 (transmission angle near 0), and the crane's luffing cylinder near its stroke limits.

@@ -1,4 +1,4 @@
-"""Hard case: frequency bands from 0 Hz hold every rigid-body mode (issue 18).
+"""Hard case: frequency bands from 0 Hz hold every rigid-body mode.
 
 The computed ω² of a rigid-body mode is round-off of either sign (~1e-17 of the
 eigenvalue scale). Naive band selection ``ω² >= 0`` kept the modes rounded up and dropped

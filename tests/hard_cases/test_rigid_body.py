@@ -1,4 +1,4 @@
-"""Hard case 1: free-free frames and shafts (issue 9).
+"""Hard case 1: free-free frames and shafts.
 
 Exactly six rigid-body modes, none lost or duplicated, and never a factorisation of the
 singular K: full model (dense and sparse paths), reduced models (Guyan, Craig-Bampton),

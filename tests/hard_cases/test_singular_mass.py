@@ -1,4 +1,4 @@
-"""Hard case 4: singular mass matrices (issue 9).
+"""Hard case 4: singular mass matrices.
 
 A lumped-mass shaft (massless beam elements, point masses without rotary inertia: the
 rotational DOFs carry no mass) and a cam mechanism whose follower touches the cam through

@@ -1,4 +1,4 @@
-"""Hard case 2: stiffness contrast (issue 9).
+"""Hard case 2: stiffness contrast.
 
 A slender steel tube (2 m, d = 40 mm) carrying a 20 kg motor runs in bearings of 1e12 N/m
 (and N m/rad) that sit on mounts of 1e3 N/m (1e2 N m/rad); each bearing is joined to the

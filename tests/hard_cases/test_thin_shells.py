@@ -1,4 +1,4 @@
-"""Hard case 6: thin shells (issue 9).
+"""Hard case 6: thin shells.
 
 Steel plates 1 m x 1 m at span/thickness 1e3 and 1e4 (t = 1 mm, 0.1 mm), with regular,
 distorted (interior nodes moved by up to 30 % of the element size) and warped

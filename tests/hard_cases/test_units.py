@@ -1,4 +1,4 @@
-"""Hard case 7: units and scaling (issue 9).
+"""Hard case 7: units and scaling.
 
 The same machine in m-kg-s and in mm-t-s (mm, tonne, s: force N, stress MPa, density
 t/mm³): a steel grid frame on six elastic mounts with a motor mass, reduced by

@@ -1,4 +1,4 @@
-"""Hard case 8: unsymmetric C(φ), damping, complex-conjugate pairs, flutter (issue 9).
+"""Hard case 8: unsymmetric C(φ), damping, complex-conjugate pairs, flutter.
 
 A two-mass mechanism on a base y_b that is attached to the frame, with a circulatory
 (follower-type) coupling force of size P between its two coordinates:

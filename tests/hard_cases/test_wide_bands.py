@@ -1,4 +1,4 @@
-"""Hard case 9: high mode counts and wide bands (issue 9).
+"""Hard case 9: high mode counts and wide bands.
 
 A pinned-pinned steel shaft (L = 10 m, d = 50 mm, Euler-Bernoulli: no shear, no rotary
 inertia), one end held in torsion, n elements (6 n DOFs): bending in two equal planes

@@ -1,4 +1,4 @@
-"""Issue 21 item 7: cam laws by name, rise–dwell–return programmes in degrees, their
+"""Cam laws by name, rise–dwell–return programmes in degrees, their
 breakpoints, and speed ramps shaped by any law.
 
 Reference peak values (unit rise over unit angle, s' = C_v, max |s''| = C_a, max |s'''|

@@ -1,4 +1,4 @@
-"""Issue 21 item 7: ``coupled_floquet`` on an undamped frame.
+"""``coupled_floquet`` on an undamped frame.
 
 The cam of Table 5.1 case 1 on the simply supported beam of tests/test_stability.py,
 without frame damping. Why ρ = 1.000 came out: 15 of the 20 coupled quasi-modes (the

@@ -1,4 +1,4 @@
-"""Issue 21 item 7: a mechanism-only tracked sweep and static equilibrium (operating point).
+"""A mechanism-only tracked sweep and static equilibrium (operating point).
 
 * ``femmech.analysis.sweep.sweep`` of a mechanism model alone (no frame): the same
   frequencies as :func:`femmech.mechanisms.quasi_modes` at each angle, and tracking

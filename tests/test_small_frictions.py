@@ -1,4 +1,4 @@
-"""Small frictions of issue 22, item 5: the residual warning names the mode and its
+"""Small frictions: the residual warning names the mode and its
 frequency; the count of n_modes includes rigid-body modes (docstrings and the report note);
 the section shear coefficient's ν is documented where users set it."""
 
