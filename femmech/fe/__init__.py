@@ -1,7 +1,8 @@
 """Stage 2, the finite-element model: meshes, sections, materials, elements, assembly.
 
 Data flow: mesh (:mod:`.mesh`, :mod:`.generators`; files through :mod:`.mesh_io`, with
-their sets by :mod:`.mesh_sets`, :mod:`.abaqus_sets`, :mod:`.nastran_sets`) → properties
+their sets by :mod:`.mesh_sets`, :mod:`.abaqus_sets`, :mod:`.nastran_sets`, the lines meshio
+may not see hidden by :mod:`.deck_lines`) → properties
 (:mod:`.sections`, :mod:`.materials`) → element matrices (:mod:`.elements`) → sparse
 global K, M (:mod:`.assembly`, :mod:`.dofs`) → supports, links, point masses and springs
 (:mod:`.constraints`, :mod:`.lumped`) → :class:`~femmech.fe.model.FEModel`

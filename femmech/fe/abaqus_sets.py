@@ -28,13 +28,13 @@ fe.mesh_sets (limits).
 
 from __future__ import annotations
 
-import io
 from array import array
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from femmech.errors import FileFormatError, did_you_mean
+from femmech.fe.deck_lines import HiddenLines
 from femmech.fe.mesh import MAX_CELLS, MAX_NODES
 from femmech.fe.mesh_sets import MAX_SET_MEMBERS, MAX_SETS
 
@@ -447,25 +447,16 @@ class _Resolver:
         return np.concatenate(parts) if parts else np.empty(0, dtype=np.int64)
 
 
-class WithoutSets(io.TextIOBase):
+class WithoutSets(HiddenLines):
     """The lines of an open deck without its ``*NSET`` and ``*ELSET`` blocks, for meshio's
     Abaqus reader (which reads by ``readline`` only): sets are read by :func:`deck_sets`,
     and meshio would stop at forms it does not know (``GENERATE`` with two numbers)."""
 
     def __init__(self, f):
-        super().__init__()
-        self.f, self.skipping = f, False
+        super().__init__(f)
+        self.skipping = False
 
-    def readable(self) -> bool:
-        return True
-
-    def read(self, size=-1):  # meshio tells a buffer by its read attribute
-        raise io.UnsupportedOperation("read by lines")
-
-    def readline(self, size=-1) -> str:
-        while True:
-            line = self.f.readline()
-            if line.startswith("*") and not line.startswith("**"):
-                self.skipping = _parameters(line.strip())[0] in ("NSET", "ELSET")
-            if not line or not self.skipping:
-                return line
+    def hides(self, line: str) -> bool:
+        if line.startswith("*") and not line.startswith("**"):
+            self.skipping = _parameters(line.strip())[0] in ("NSET", "ELSET")
+        return self.skipping

@@ -25,13 +25,13 @@ fe.nastran_sets (the card reader).
 
 from __future__ import annotations
 
-import io
 from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from femmech.errors import FileFormatError
+from femmech.fe.deck_lines import HiddenLines
 from femmech.fe.nastran_sets import SET_CARDS, bulk_cards
 
 LINE_CARDS = ("CBAR", "CBEAM", "CBUSH", "CBUSH1D", "CGAP")
@@ -206,29 +206,20 @@ def _unique(ids: np.ndarray, what, where) -> None:
                               " once): give each its own number")
 
 
-class WithoutCards(io.TextIOBase):
+class WithoutCards(HiddenLines):
     """The lines of an open deck without the bulk data cards :data:`HIDDEN_CARDS` (and
     their continuation lines), for meshio's Nastran reader (which reads by ``readline``)."""
 
     def __init__(self, f):
-        super().__init__()
-        self.f, self.in_bulk, self.skipping = f, False, False
+        super().__init__(f)
+        self.in_bulk, self.skipping = False, False
 
-    def readable(self) -> bool:
-        return True
-
-    def read(self, size=-1):  # meshio tells a buffer by its read attribute
-        raise io.UnsupportedOperation("read by lines")
-
-    def readline(self, size=-1) -> str:
-        while True:
-            line = self.f.readline()
-            text = line.rstrip("\r\n")
-            if not self.in_bulk:
-                self.in_bulk = text.strip().upper().startswith("BEGIN BULK")
-                return line
-            head = text.split(",", 1)[0] if "," in text else text[:8]
-            if head[:1] not in ("+", "*", "$") and head.strip():  # a card's first line
-                self.skipping = head.strip() in HIDDEN_CARDS
-            if not line or not self.skipping:
-                return line
+    def hides(self, line: str) -> bool:
+        text = line.rstrip("\r\n")
+        if not self.in_bulk:
+            self.in_bulk = text.strip().upper().startswith("BEGIN BULK")
+            return False
+        head = text.split(",", 1)[0] if "," in text else text[:8]
+        if head[:1] not in ("+", "*", "$") and head.strip():  # a card's first line
+            self.skipping = head.strip() in HIDDEN_CARDS
+        return self.skipping
