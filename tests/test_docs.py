@@ -38,6 +38,36 @@ def test_python_blocks_run_as_written(path, tmp_path, monkeypatch):
     for i, block in enumerate(python_blocks(path)):
         code = compile(block, f"{path.name}, python block {i + 1}", "exec")
         exec(code, namespace)  # noqa: S102 - the repository's own documentation
+    if path.name == "README.md":
+        check_tour_outputs(tmp_path)
+
+
+TOUR_OUTPUT = "out/tour"
+"""The folder the README's tour declares for every file it writes."""
+TOUR_FILES = {"mode1.png", "modes.vtu", "modes.pvd", "modes_steps", "frame_se.npz"}
+"""What the tour says it writes there."""
+
+
+def check_tour_outputs(folder: Path) -> None:
+    """The tour wrote its files into TOUR_OUTPUT and nothing anywhere else below ``folder``
+    (the working folder it ran from, holding only the links to meshes/ and examples/)."""
+    rel = [p.relative_to(folder) for p in folder.rglob("*")]
+    outside = sorted(r.as_posix() for r in rel if r.parts[0] not in ("meshes", "examples")
+                     and r != Path("out") and not r.is_relative_to(TOUR_OUTPUT))
+    assert not outside, f"the README's tour wrote {outside} outside {TOUR_OUTPUT}/"
+    written = {p.name for p in (folder / TOUR_OUTPUT).iterdir()}
+    assert written == TOUR_FILES, written
+    assert any((folder / TOUR_OUTPUT / "modes_steps").iterdir())
+
+
+def test_readme_declares_the_tour_output_folder():
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    tour = text.split("## A tour of the API", 1)[1].split("\n## ", 1)[0]
+    assert f"`{TOUR_OUTPUT}/`" in tour
+    assert f'Path("{TOUR_OUTPUT}")' in tour
+    for name in TOUR_FILES:  # each output is named where the outputs are described
+        assert name in tour, name
+    assert "`modes_steps/`" in text.split("## A tour of the API", 1)[0]  # the quick start
 
 
 def test_every_relative_link_resolves():
