@@ -85,3 +85,23 @@ def test_every_relative_link_resolves():
                 broken.append(f"{path.name}: {target} (no heading #{anchor})")
     assert checked >= 5  # the docs do link to each other
     assert not broken, broken
+
+
+HISTORY = re.compile(r"\bissue\s*\d+|the issue|--suite issue", re.I)
+"""Development history that user docs do not carry: issue numbers, "the issue's ...",
+the benchmark suites' old names."""
+
+
+@pytest.mark.parametrize("path", [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))],
+                         ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_user_docs_carry_no_development_history(path):
+    found = [f"{path.name}:{n}: {m.group(0)!r}"
+             for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+             for m in HISTORY.finditer(line)]
+    assert not found, found
+
+
+def test_benchmark_docs_use_the_current_suite_names():
+    text = (ROOT / "benchmarks" / "README.md").read_text(encoding="utf-8")
+    assert "--suite issue" not in text
+    assert "--suite components" in text
