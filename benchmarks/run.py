@@ -1,5 +1,6 @@
-"""Benchmark suites: femmech against its peers, and femmech's components against their
-targets; one table file each.
+"""Benchmark suites: femmech against its peers, femmech's own stages against their targets.
+
+One table file per entry.
 
 Usage::
 
