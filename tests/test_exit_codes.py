@@ -173,3 +173,14 @@ def test_missing_mesh_file_exit_code_of_the_process(tmp_path):
     assert done.returncode == 3, done.stderr
     assert "/../" not in done.stderr
     assert done.stderr.count("\n") == 1
+
+
+def test_missing_scene_module_path_is_normalised(tmp_path, capsys):
+    scene = tmp_path / "examples" / "machine.toml"
+    scene.parent.mkdir()
+    scene.write_text('[scene]\nname = "m"\n\n[mechanisms.cam]\nmodule = "../code/nowhere.py"\n'
+                     'function = "build"\n')
+    assert main(["check", str(scene)]) == 3
+    missing = (tmp_path / "code" / "nowhere.py").resolve()
+    assert error_line(capsys) == (f"error: machine.toml: [mechanisms.cam] module: file not"
+                                  f" found: {missing}")
