@@ -9,8 +9,8 @@ Exit codes (:data:`EXIT_CODES`):
       traceback with ``--debug``)
 2     usage error: the command line is invalid (argparse)
 3     input error: a scene, mesh, superelement or cache file is invalid or missing (a
-      path that does not exist, or a folder where a file belongs), or the scene's Python
-      code was refused or failed (one line naming the file and the item)
+      path that does not exist, or a folder where a file belongs or the reverse), or the
+      scene's Python code was refused or failed (one line naming the file and the item)
 4     numerical failure: a computation on valid input failed (naming the analysis)
 5     file-system error: an existing file or folder could not be read or written
       (permission denied, disk full)
