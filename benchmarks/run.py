@@ -1,12 +1,13 @@
-"""Benchmark suite: femmech against its peers (issue 24) and the issue-10 entries, one table
-file each.
+"""Benchmark suites: femmech against its peers, femmech's own stages against their targets.
+
+One table file per entry.
 
 Usage::
 
-    python benchmarks/run.py [--suite peers|issue10] [--size tiny|small|medium|large]
+    python benchmarks/run.py [--suite peers|components] [--size tiny|small|medium|large]
                              [--repeats N] [--only NAME ...] [--out DIR] [--blas-threads N]
 
-The default suite ``peers`` prints one table per target of issue 24, each with femmech and
+The default suite ``peers`` prints one table per performance target, each with femmech and
 the tool a user would run instead on the same matrices in the same process (min / median
 of ``--repeats`` interleaved runs per side, the ratio of the minima, the error of each side,
 a verdict against the target, and an idle baseline before and after; benchmarks/peers.py):
@@ -27,7 +28,9 @@ a verdict against the target, and an idle baseline before and after; benchmarks/
   (peer_memory.py; no peer: the 8 GB target is absolute);
 - ``t7_exudyn``: Craig-Bampton vs Exudyn's Hurty-Craig-Bampton (peer_exudyn.py).
 
-The ``issue10`` suite keeps the older entries below.
+The ``components`` suite times femmech's own stages against their targets (below). The
+old suite names ``issue10`` (= ``components``) and ``issue24`` (= ``peers``) still work,
+with a deprecation message.
 
 Runs the entries below one after the other in this process, prints a table per entry and
 writes it to ``benchmarks/results/<name>.txt`` (atomically). Every table starts with the
@@ -35,7 +38,7 @@ same header: machine (CPU, cores, memory, load average at start and end of the e
 library versions (numpy, scipy, scikit-fem, femmech, MKL/PARDISO, scikit-sparse, exudyn)
 and the solver and thread settings (:mod:`femmech.solve.direct`, :mod:`femmech.solve.threads`).
 
-Entries of the ``issue10`` suite (each reuses the ``main`` of a benchmark module in this folder):
+Entries of the ``components`` suite (each reuses the ``main`` of a benchmark module in this folder):
 
 - ``assembly``: ``build_model`` split into element matrices, COO → CSR, Tᵀ K T, and its
   ratio to one 20-mode eigensolve of the same frame (frame_modes.py);
@@ -69,6 +72,7 @@ import platform
 import sys
 import time
 import traceback
+import warnings
 from contextlib import nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -106,8 +110,8 @@ scale = _sibling("scale")
 
 RESULTS = HERE / "results"
 SIZES = ("tiny", "small", "medium", "large")
-ASSEMBLY_TARGET = 0.2  # issue 10: assembly <= 20 % of one full eigensolve
-SWEEP_TARGET_S = 0.5  # issue 10: 360 angles with vectors, r <= 100, <= 0.5 s
+ASSEMBLY_TARGET = 0.2  # target: assembly <= 20 % of one full eigensolve
+SWEEP_TARGET_S = 0.5  # target: 360 angles with vectors, r <= 100, <= 0.5 s
 # Craig-Bampton bases beside the default (f_max 400 Hz + residual vectors) in `coupled`:
 # (f_max_hz, residual_vectors); the band's highest mode is ~160 Hz (12 cams)
 REDUCTION_VARIANTS = ((400.0, True), (400.0, False), (100.0, False))
@@ -238,7 +242,7 @@ def entry_reduced_sweep(size):
         "Reduced coupled sweep (textile shaft with N cams, Craig-Bampton + residual vectors,"
         f" N + 2 modes tracked, solve-phase BLAS threads {threads.settings().solve or 'all'})",
         ["cams N", "coordinates r", "angles", "vectors", "modes", "sweep s", "ms/angle"], lines)
-    return table + [f"target (issue 10): 360 angles with vectors, r <= 100, <= {SWEEP_TARGET_S}"
+    return table + [f"target: 360 angles with vectors, r <= 100, <= {SWEEP_TARGET_S}"
                     " s", ""], rows
 
 
@@ -268,14 +272,14 @@ def entry_coupled(size):
          "speedup", "max |df|/f", "min MAC"], lines)
     notes = [f"reduced ms/angle: the tracked sweep over {n_angles} angles with vectors,"
              f" divided by the angles; errors and MAC (by order) over the {rows[0]['n_modes']}"
-             " lowest modes (the lowest, the N cam followers' cluster, the next one); issue 10"
+             " lowest modes (the lowest, the N cam followers' cluster, the next one);"
              " target: >= 10 000x at ~150k DOFs with <= 1e-3 error.",
              *(f"FE {r['fe_free_dofs']:,} free DOFs: build {r['build_s']:.2f} s (reduction"
                f" {r['reduction_s']:.2f} s), mean full {r['full_per_angle_ms']:.1f} ms,"
                f" speedup {r['speedup']:.0f}x, max error {r['max_rel_error']:.1e}"
                for r in rows), ""]
     table += frame_modes._table(
-        "The issue's reference: full coupled solve by scipy eigsh (ARPACK, shift-invert at"
+        "Reference: full coupled solve by scipy eigsh (ARPACK, shift-invert at"
         " femmech's shift on the same backend, tol 0) vs femmech's full solve, one angle",
         ["FE free DOFs", "full n", "angle deg", "femmech full s", "ARPACK s", "ARPACK solves",
          "max |dλ|/λ", "reduced ms/angle", "speedup vs ARPACK"],
@@ -311,7 +315,7 @@ def entry_exudyn_hcb(size):
         pair = [r for r in rows if r["case"] == case]
         best = min(r["exudyn_s"] for r in pair) / min(r["femmech_s"] for r in pair)
         lines.append(f"{case}: best Exudyn time / best femmech time (over the thread"
-                     f" settings) = {best:.1f}x (issue 10 target: >= 2x at ~20k, >= 5x at"
+                     f" settings) = {best:.1f}x (target: >= 2x at ~20k, >= 5x at"
                      " ~150k DOFs)")
     return lines + [""], rows
 
@@ -321,7 +325,7 @@ def entry_scale(size):
     return scale.format_report(row, header=False) + [""], [row]
 
 
-PEER_TARGETS = {  # issue 24: one table per target, femmech beside the peer a user would run
+PEER_TARGETS = {  # one table per target, femmech beside the peer a user would run
     "t1_eigensolve": "peer_eigensolve",
     "t2_craig_bampton": "peer_craig_bampton",
     "t3_interface": "peer_interface",
@@ -343,7 +347,7 @@ def _peer_entry(module_name: str):
 
 PEERS = {name: _peer_entry(module) for name, module in PEER_TARGETS.items()}
 
-ISSUE10 = {
+COMPONENTS = {
     "assembly": entry_assembly,
     "eigensolve": entry_eigensolve,
     "craig_bampton": entry_craig_bampton,
@@ -352,8 +356,21 @@ ISSUE10 = {
     "exudyn_hcb": entry_exudyn_hcb,
     "scale": entry_scale,
 }
-SUITES = {"peers": PEERS, "issue10": ISSUE10}
-ENTRIES = {**PEERS, **ISSUE10}
+SUITES = {"peers": PEERS, "components": COMPONENTS}
+SUITE_ALIASES = {"issue10": "components", "issue24": "peers"}
+"""Old suite names → current ones (deprecated; they still run, with a message)."""
+ENTRIES = {**PEERS, **COMPONENTS}
+
+
+def suite_name(suite: str) -> str:
+    """The current name of ``suite``; an old name gives a DeprecationWarning naming the
+    new one."""
+    if suite in SUITE_ALIASES:
+        new = SUITE_ALIASES[suite]
+        warnings.warn(f"benchmark suite {suite!r} is deprecated; use {new!r}"
+                      f" (--suite {new})", DeprecationWarning, stacklevel=3)
+        return new
+    return suite
 
 
 # --- runner ---------------------------------------------------------------------------
@@ -395,6 +412,7 @@ def main(size: str = "small", only=None, out_dir=RESULTS, echo=True,
     global REPEATS
     if size not in SIZES:
         raise ValueError(f"unknown size {size!r}; choose from {list(SIZES)}")
+    suite = suite_name(suite)
     if suite not in SUITES:
         raise ValueError(f"unknown suite {suite!r}; choose from {list(SUITES)}")
     if repeats < 1:
@@ -422,9 +440,10 @@ def main(size: str = "small", only=None, out_dir=RESULTS, echo=True,
 
 def _cli(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--suite", choices=tuple(SUITES), default="peers",
-                        help="peers: issue 24's seven targets (default); issue10: the"
-                        " older entries")
+    parser.add_argument("--suite", choices=(*SUITES, *SUITE_ALIASES), default="peers",
+                        help="peers: femmech against its peers, one table per target"
+                        " (default); components: femmech's own stages against their"
+                        " targets (issue10 and issue24: deprecated old names)")
     parser.add_argument("--size", choices=SIZES, default="small")
     parser.add_argument("--repeats", type=int, default=REPEATS,
                         help="runs per side of each peer comparison (min / median)")
@@ -434,6 +453,10 @@ def _cli(argv=None) -> int:
     parser.add_argument("--blas-threads", type=int, default=None,
                         help="limit every BLAS/OpenMP library to N threads for the whole run")
     args = parser.parse_args(argv)
+    if args.suite in SUITE_ALIASES:
+        new = SUITE_ALIASES[args.suite]
+        print(f"note: --suite {args.suite} is deprecated; use --suite {new}", file=sys.stderr)
+        args.suite = new
     results = main(args.size, args.only, args.out, blas_threads=args.blas_threads,
                    suite=args.suite, repeats=args.repeats)
     failed = [name for name, r in results.items() if r.error]

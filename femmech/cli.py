@@ -8,11 +8,12 @@ Exit codes (:data:`EXIT_CODES`):
 1     internal error: an unexpected exception, i.e. a bug in femmech (one line; the
       traceback with ``--debug``)
 2     usage error: the command line is invalid (argparse)
-3     input error: a scene, mesh, superelement or cache file is invalid, or the scene's
-      Python code was refused or failed (one line naming the file and the item)
+3     input error: a scene, mesh, superelement or cache file is invalid or missing (a
+      path that does not exist, or a folder where a file belongs or the reverse), or the
+      scene's Python code was refused or failed (one line naming the file and the item)
 4     numerical failure: a computation on valid input failed (naming the analysis)
-5     file-system error: a file or folder could not be read or written (permission, full
-      disk)
+5     file-system error: an existing file or folder could not be read or written
+      (permission denied, disk full)
 130   interrupted (Ctrl-C)
 ====  ===================================================================================
 

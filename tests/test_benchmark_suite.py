@@ -1,5 +1,5 @@
-"""Smoke test of the older benchmark suite (benchmarks/run.py --suite issue10) at size
-tiny: no timing assertions. The peer suite is tests/test_benchmarks_peers.py."""
+"""Smoke test of the components benchmark suite (benchmarks/run.py --suite components) at
+size tiny: no timing assertions. The peer suite is tests/test_benchmarks_peers.py."""
 
 import importlib.util
 import math
@@ -29,7 +29,7 @@ def suite():
 @pytest.fixture(scope="module")
 def tiny(suite, tmp_path_factory):
     out = tmp_path_factory.mktemp("results")
-    return suite.main("tiny", out_dir=out, echo=False, suite="issue10"), out
+    return suite.main("tiny", out_dir=out, echo=False, suite="components"), out
 
 
 def _numbers(value):
@@ -49,7 +49,7 @@ def _numbers(value):
 
 def test_every_entry_runs_and_writes_a_table_with_the_header(suite, tiny):
     results, out = tiny
-    assert list(results) == list(suite.ISSUE10)
+    assert list(results) == list(suite.COMPONENTS)
     for name, result in results.items():
         assert result.error is None, f"{name}: {result.error}"
         text = (out / f"{name}.txt").read_text()
@@ -155,3 +155,21 @@ def test_bad_arguments_are_named(suite, tmp_path):
     with pytest.raises(ValueError, match="variants need n_check > 0"):
         suite.coupled_sweep.main(n_cams=4, n_angles=12, n_check=0, per_spacing=2,
                                  variants=((400.0, True),))
+
+
+def test_old_suite_names_still_run_with_a_deprecation_message(suite, monkeypatch, tmp_path,
+                                                              capsys):
+    monkeypatch.setattr(suite.exudyn_hcb, "exudyn_version", lambda: None)  # a fast entry
+    assert set(suite.SUITES) == {"peers", "components"}
+    for old, new in (("issue10", "components"), ("issue24", "peers")):
+        assert suite.SUITE_ALIASES[old] == new
+        with pytest.warns(DeprecationWarning, match=f"'{old}' is deprecated; use '{new}'"):
+            results = suite.main("tiny", only=["exudyn_hcb"], out_dir=None, echo=False,
+                                 suite=old)
+        assert list(results) == ["exudyn_hcb"]
+    code = suite._cli(["--suite", "issue10", "--size", "tiny", "--only", "exudyn_hcb",
+                       "--out", str(tmp_path)])
+    assert code == 0
+    assert "--suite issue10 is deprecated; use --suite components" in capsys.readouterr().err
+    with pytest.raises(ValueError, match="unknown suite 'issue99'"):
+        suite.main("tiny", out_dir=None, echo=False, suite="issue99")

@@ -26,7 +26,14 @@ from femmech.errors import SceneError
 from femmech.scene.analyses import MAX_MODES, Analyses, read_analyses
 from femmech.scene.chain import chain_analyses, read_chain, read_synthesis
 from femmech.scene.mesh import MeshSpec, read_mesh_spec, resolve_auto_band
-from femmech.scene.reader import MAX_SCENE_BYTES, Reader, check_limits, one_line, show
+from femmech.scene.reader import (
+    MAX_SCENE_BYTES,
+    Reader,
+    check_limits,
+    file_path,
+    one_line,
+    show,
+)
 from femmech.scene.units import (
     AREA,
     DENSITY,
@@ -222,7 +229,8 @@ def load_scene(path) -> Scene:
     raises SceneError (one line) when invalid."""
     path = Path(path)
     if not path.is_file():
-        raise SceneError(one_line(f"{path}: scene file not found"))
+        raise SceneError(one_line(f"{path.name}: scene file not found:"
+                                  f" {file_path(Path(), path)}"))
     name = one_line(path.name)
     size = path.stat().st_size
     if size > MAX_SCENE_BYTES:

@@ -29,7 +29,7 @@ from femmech.mechanisms import (
     table_5_1_case,
 )
 from femmech.mechanisms.motion_laws import LAWS
-from femmech.scene.reader import Reader, show
+from femmech.scene.reader import Reader, file_path, show
 from femmech.scene.units import (
     ACCELERATION,
     ANGLE,
@@ -186,7 +186,7 @@ def read_mechanisms(root: Reader, base: Path) -> dict:
         model = r.string("model", None, choices=tuple(BUILTIN_MODELS))
         module = function = None
         if model is None:
-            module = base / r.string("module")
+            module = file_path(base, r.string("module"))
             if not module.is_file():
                 raise r.error("module", f"file not found: {module}")
             module, function = str(module), r.string("function")

@@ -28,7 +28,7 @@ from femmech.fe.generators import (
     rectangular_plate_size,
 )
 from femmech.fe.mesh import MAX_CELLS, MAX_NODES, NODES_PER_CELL
-from femmech.scene.reader import Reader, one_line, show
+from femmech.scene.reader import Reader, file_path, one_line, show
 from femmech.scene.units import FREQUENCY, LENGTH
 
 GENERATORS = ("grid_frame", "members", "rectangular_plate", "box")
@@ -82,7 +82,7 @@ def read_mesh_spec(r: Reader, base: Path) -> MeshSpec:
     edges = r.strings("edge_node_groups", ())
     merge = r.number("merge_nodes", LENGTH, None, positive=True)
     if r.has("mesh") and not auto:
-        file = base / r.string("mesh")
+        file = file_path(base, r.string("mesh"))
         try:
             found = file.is_file()
         except (OSError, ValueError):  # a name too long or with a NUL byte

@@ -15,7 +15,9 @@ Stage 8 (scene), reading: uses scene.units and fe.mesh (limits on mesh sizes).
 from __future__ import annotations
 
 import difflib
+import os
 import re
+from pathlib import Path
 
 from femmech.errors import SceneError
 from femmech.fe.mesh import MAX_NODES
@@ -58,6 +60,19 @@ def key_text(key) -> str:
 def one_line(text: str) -> str:
     """``text`` with every line break escaped (messages stay one line)."""
     return text.translate(_LINE_BREAKS)
+
+
+def file_path(base, name) -> Path:
+    """The file ``name`` (a scene value, or a path given by the user) relative to the
+    folder ``base``: absolute, with ``..`` and symbolic links resolved, as files are read
+    and as messages show them (``/x/meshes/frame.msh``, not
+    ``/x/examples/../meshes/frame.msh``). A name that cannot be resolved (a NUL byte, a
+    loop of links) is only normalised."""
+    path = Path(base) / name
+    try:
+        return path.resolve()
+    except (OSError, ValueError, RuntimeError):
+        return Path(os.path.normpath(path.absolute()))
 
 
 def closest(word, names) -> str | None:
