@@ -197,10 +197,10 @@ def test_processing_machine_follower_deformation_is_the_follower_resonance(machi
     # 4-DOF model (rigid frame, elastic shaft: seed 5.2.3.2 eqs. 20-23, errata 29-33),
     # solved by Fourier collocation instead of time integration: 9.59 / 18.20 mm
     # (N = 512 and 1024 agree to 6e-5). The coupled model differs by -3.3 % / +1.9 %,
-    # because the frame and bearings lower the follower branches by about 0.4 %
-    # (80.20-87.17 Hz coupled, 80.54-87.54 Hz rigid). Near resonance (dynamic
+    # because the frame and bearings lower the follower branches by 0.4 to 0.7 %
+    # (80.20-91.51 Hz coupled, 80.54-92.12 Hz rigid, 73 angles). Near resonance (dynamic
     # amplification 5.7 of the 4th harmonic, frequency ratio r = 0.914) the amplitude
-    # changes by about 2r^2/(1 - r^2) = 10 times that shift, so the bound is 6 %.
+    # changes by about 2r^2/(1 - r^2) = 10 times that shift, 4 to 7 %: bound 8 %.
     W = 2 * np.pi * machine.OPERATING_RPM / 60.0
     base, _, _, _ = machine.build()
     r, system, _ = machine.steady_state(base, steady_steps=machine.QUICK["steady_steps"])
@@ -210,7 +210,7 @@ def test_processing_machine_follower_deformation_is_the_follower_resonance(machi
                          processing_machine_cams())
     reference = np.abs(_collocation_steady_state(chapter, W, 512)[:, 2:]).max(axis=0)
     assert_allclose(reference, [9.59e-3, 18.20e-3], rtol=1e-3)
-    assert_allclose(np.abs(q).max(axis=0), reference, rtol=0.06)
+    assert_allclose(np.abs(q).max(axis=0), reference, rtol=0.08)
     # It is a resonance and not a slip: the quasi-static deformation under the peak
     # inertia force, m max|U''| Ω² / c (4.30 / 4.93 mm), is exceeded 2.2 / 3.8 times, and
     # the harmonics next to the follower modes (92.1 / 87.5 Hz on a rigid cam, 4.61 / 4.38
@@ -232,6 +232,7 @@ def test_processing_machine_scene_runs_the_scripts_steady_state(machine):
 
     response = load_scene(EXAMPLES / "processing_machine.toml").analyses.response
     assert response.kind == "periodic"
+    # bound: "1200 rpm" converted by the unit parser: a few eps of round-off
     assert response.speed == pytest.approx(2 * np.pi * machine.OPERATING_RPM / 60.0,
                                            rel=1e-12)
     assert_allclose(response.rayleigh,
