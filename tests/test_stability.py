@@ -341,6 +341,24 @@ def test_spectral_radius_is_continuous_in_speed(damped_cam_system):
     assert chart.stable.all()
 
 
+def test_chart_points_pass_through_a_progress_wrapper(damped_cam_system):
+    # A progress bar (tqdm, femmech.scene.workshop.progress) wraps the chart's points in
+    # the order they are computed; the chart is the same with or without it.
+    seen = []
+
+    def record(points):
+        for point in points:
+            seen.append(point)
+            yield point
+
+    speeds = [30.0, 40.0]
+    chart = stability_chart(damped_cam_system, speeds, n_steps=64, progress=record)
+    assert seen == [(0, 0), (0, 1)]
+    plain = stability_chart(damped_cam_system, speeds, n_steps=64)
+    # bound: the same arithmetic in the same order: bit-identical
+    assert_allclose(chart.spectral_radius, plain.spectral_radius, rtol=0.0, atol=0.0)
+
+
 def test_errors_name_the_problem(damped_cam_system):
     with pytest.raises(ValueError, match="Omega must be positive"):
         coupled_monodromy(damped_cam_system, 0.0)

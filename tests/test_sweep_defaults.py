@@ -184,7 +184,10 @@ def test_speed_study_defaults_fit_a_small_machine():
 
     system = _three_coordinate_machine()
     assert system.n == 3
-    study = speed_study(system, [20.0, 40.0], 0.02, (5.0, 200.0), n_steps=16)
+    counted = []
+    study = speed_study(system, [20.0, 40.0], 0.02, (5.0, 200.0), [0.01], n_steps=16,
+                        progress=lambda points: counted.append(len(points)) or points)
+    assert counted == [2, 2]  # the speed line, then the (ζ, speed) chart of 1 x 2 points
     assert study.notes == ("basis_modes not given: all 2 branches of the system (3"
                            " coordinates; the default is 8)",)
     assert study.notes[0] in study.summary()

@@ -158,7 +158,7 @@ def stability_chart(system_or_callable, speeds, second_parameter_values=None,
                     n_steps: int = 32, angle_period: float = 2 * np.pi, tol: float = 1e-6,
                     parameter_name: str = "parameter",
                     basis: np.ndarray | None = None, rtol: float = RTOL,
-                    max_steps: int = MAX_STEPS) -> StabilityChart:
+                    max_steps: int = MAX_STEPS, progress=None) -> StabilityChart:
     """Spectral radius of the monodromy matrix over drive speed (and a second parameter).
 
     Parameters
@@ -180,6 +180,9 @@ def stability_chart(system_or_callable, speeds, second_parameter_values=None,
     basis : ndarray (n, r), optional
         Ritz basis for coupled systems (:func:`coupled_monodromy`); the same for every
         point of the chart.
+    progress : callable, optional
+        Wraps the list of chart points ``(row, speed index)`` as they are computed, e.g.
+        a ``tqdm`` progress bar (:func:`femmech.scene.workshop.progress`).
 
     Returns
     -------
@@ -213,12 +216,13 @@ def stability_chart(system_or_callable, speeds, second_parameter_values=None,
     shape = (len(rows), speeds.size)
     radius, periods, error = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     converged, steps = np.zeros(shape, dtype=bool), np.zeros(shape, dtype=int)
-    for i, p in enumerate(rows):
-        for j, W in enumerate(speeds):
-            record, periods[i, j] = _point(build(W, p), W, n_steps, angle_period, basis,
-                                           rtol, max_steps)
-            radius[i, j], error[i, j] = record.spectral_radius, record.error
-            converged[i, j], steps[i, j] = bool(record.converged), record.n_steps
+    points = [(i, j) for i in range(len(rows)) for j in range(speeds.size)]
+    for i, j in (progress or iter)(points):
+        W = speeds[j]
+        record, periods[i, j] = _point(build(W, rows[i]), W, n_steps, angle_period, basis,
+                                       rtol, max_steps)
+        radius[i, j], error[i, j] = record.spectral_radius, record.error
+        converged[i, j], steps[i, j] = bool(record.converged), record.n_steps
     chart = StabilityChart(speeds, values, radius, radius <= 1.0 + tol, tol, parameter_name,
                            periods, error, converged, steps, float(rtol))
     warn_unconverged_chart(chart)
@@ -307,7 +311,7 @@ def speed_study(system: CoupledSystem, speeds, zeta: float, band_hz: tuple[float
                 damping_ratios=None, n_steps: int = 32, basis_modes: int | None = None,
                 marked_branches: int | None = None, orders=range(1, 13),
                 angle_period: float = 2 * np.pi, rtol: float = RTOL,
-                max_steps: int = MAX_STEPS) -> SpeedStudy:
+                max_steps: int = MAX_STEPS, progress=None) -> SpeedStudy:
     """Stability of a machine over speed, with Rayleigh frame damping, in one call.
 
     ``system`` carries the mechanisms' own damping but no frame damping; the frame gets
@@ -337,6 +341,8 @@ def speed_study(system: CoupledSystem, speeds, zeta: float, band_hz: tuple[float
         defaults are said in :attr:`SpeedStudy.notes`.
     orders : sequence of int
         Harmonic orders j of the marks.
+    progress : callable, optional
+        Wraps the points of the speed line and of the chart (:func:`stability_chart`).
     """
     speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
 
@@ -360,13 +366,14 @@ def speed_study(system: CoupledSystem, speeds, zeta: float, band_hz: tuple[float
     mean_hz = sweep(nominal, phi, n_modes=marked_branches).freq_hz.mean(axis=0)
     marks = resonance_speeds(mean_hz, orders, within=(speeds.min(), speeds.max()))
     line = stability_chart(nominal, speeds, n_steps=n_steps, angle_period=angle_period,
-                           basis=basis, rtol=rtol, max_steps=max_steps)
+                           basis=basis, rtol=rtol, max_steps=max_steps, progress=progress)
     chart = None
     if damping_ratios is not None:
         chart = stability_chart(lambda W, ratio: damped(ratio), speeds, damping_ratios,
                                 n_steps=n_steps, angle_period=angle_period, rtol=rtol,
                                 max_steps=max_steps,
-                                parameter_name="frame damping ratio ζ (-)", basis=basis)
+                                parameter_name="frame damping ratio ζ (-)", basis=basis,
+                                progress=progress)
     return SpeedStudy(line, chart, marks, mean_hz, basis.shape[1], float(zeta), tuple(notes))
 
 
