@@ -80,8 +80,12 @@ def _remove_stale(out: Path) -> None:
         if path.name.startswith(f".{out.name}{_TAG}old-"):
             if not os.path.lexists(out):
                 os.rename(path, out)
+                warnings.warn(FemmechWarning(
+                    f"--out {out}: a run (process {pid}) was killed during its swap; the"
+                    f" previous folder, hidden as {path.name}, is put back (interrupted swap"
+                    " recovered)"), stacklevel=4)
                 continue
-            _retire(path, out, _ours(path))
+            _retire(path, out, _ours(path), recovered=True)
         else:
             shutil.rmtree(path, ignore_errors=True)
 
@@ -211,7 +215,7 @@ def _free_name(path: Path) -> Path:
     return candidate
 
 
-def _retire(retired: Path, out: Path, ours: set[str]) -> None:
+def _retire(retired: Path, out: Path, ours: set[str], recovered: bool = False) -> None:
     """Move the user's files from the previous folder ``retired`` into ``out`` at the same
     relative places, then remove ``retired``; kept (and named in a warning) if a file
     could not be moved. Warns naming the files carried into femmech's subfolders and
@@ -233,6 +237,10 @@ def _retire(retired: Path, out: Path, ours: set[str]) -> None:
     if not stuck:
         shutil.rmtree(retired, ignore_errors=True)
     notes = []
+    if recovered:
+        notes.append(f"a run killed during its swap left the previous folder as"
+                     f" {retired.name}; your files still there were moved into the folder"
+                     " (interrupted swap recovered)")
     if nested:
         notes.append(f"kept your files inside femmech's subfolders: {_listed(nested)}")
     if renamed:
