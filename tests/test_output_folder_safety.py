@@ -124,7 +124,8 @@ def test_previous_folder_retired_by_a_killed_swap_is_put_back_or_carried_over(tm
     (retired / MANIFEST).write_text(json.dumps({"by": "femmech", "files": ["old.csv"]}))
     (retired / "old.csv").write_text("femmech's")
     (retired / "precious.txt").write_text("mine")
-    _run(out, {"report.html": "r3"})
+    with pytest.warns(FemmechWarning, match="interrupted swap recovered"):
+        _run(out, {"report.html": "r3"})
     assert (out / "precious.txt").read_text() == "mine"
     assert not (out / "old.csv").exists()
     assert _hidden(tmp_path) == []
