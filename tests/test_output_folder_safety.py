@@ -115,7 +115,8 @@ def test_previous_folder_retired_by_a_killed_swap_is_put_back_or_carried_over(tm
     dead = 2 ** 22 + 12345  # above the default pid_max (2^22): no such process
     retired = tmp_path / f".out.femmech-old-{dead}-abcd1234"
     os.rename(out, retired)
-    with pytest.warns(FemmechWarning, match="modes_steps/mine.txt"):
+    with pytest.warns(FemmechWarning, match="is put back"), \
+            pytest.warns(FemmechWarning, match="modes_steps/mine.txt"):
         _run(out, {"report.html": "r2"})
     assert (out / "modes_steps" / "mine.txt").read_text() == "mine"
     assert _hidden(tmp_path) == []
