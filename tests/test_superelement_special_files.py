@@ -58,8 +58,8 @@ def test_load_refuses_what_is_no_regular_file(tmp_path, make, kind):
     path = tmp_path / "frame.npz"
     make(path)
     out = _run(LOAD, path)
-    assert out == (f"FileFormatError: {path}: is {kind}, not a regular file; a superelement"
-                   " file must be a regular file")
+    assert out == (f"FileFormatError: {path}: not a readable superelement file: it is {kind},"
+                   " not a regular file; a superelement file must be a regular file")
 
 
 def test_load_refuses_a_file_padded_far_beyond_its_members(tmp_path):
@@ -95,12 +95,13 @@ def test_the_cache_refuses_a_fifo_entry(tmp_path, which):
     if which == "manifest":
         data.write_bytes(b"x")
         os.mkfifo(manifest)
-        expected = f"reason: unreadable manifest (FileFormatError: {manifest}: is a FIFO"
+        expected = (f"reason: unreadable manifest (FileFormatError: {manifest}: not a"
+                    " readable cache manifest: it is a FIFO")
     else:
         os.mkfifo(data)
         manifest.write_text(json.dumps({"key": key, "size": 0, "sha256": "0" * 64}))
-        expected = (f"reason: not a valid superelement file (FileFormatError: {data}: is a"
-                    " FIFO")
+        expected = (f"reason: not a valid superelement file (FileFormatError: {data}: not a"
+                    " readable cache entry: it is a FIFO")
     out = _run(CACHE, tmp_path, key)
     assert out.startswith(expected), out
 
@@ -115,5 +116,6 @@ def test_the_cache_refuses_a_manifest_linked_to_dev_zero(tmp_path):
     data.write_bytes(b"x")
     os.symlink("/dev/zero", manifest)
     out = _run(CACHE, tmp_path, key)
-    assert out.startswith(f"reason: unreadable manifest (FileFormatError: {manifest}: is a"
-                          " character device (a symbolic link to /dev/zero)"), out
+    assert out.startswith(f"reason: unreadable manifest (FileFormatError: {manifest}: not a"
+                          " readable cache manifest: it is a character device (a symbolic"
+                          " link to /dev/zero)"), out

@@ -109,8 +109,8 @@ def _require_regular(info: os.stat_result, path, file: str, what: str) -> None:
     link = ""
     if os.path.islink(path):
         link = f" (a symbolic link to {_name(os.path.realpath(path))})"
-    raise FileFormatError(f"{file}: is {kind}{link}, not a regular file; a {what} must be"
-                          " a regular file")
+    raise FileFormatError(f"{file}: not a readable {what}: it is {kind}{link}, not a"
+                          f" regular file; a {what} must be a regular file")
 
 
 MAX_HEADER = 10_000

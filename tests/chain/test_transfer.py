@@ -157,8 +157,11 @@ def test_transfer_agrees_with_assembled(name, phi_deg):
     # bound: inverse iteration to ROUNDOFF_RESIDUAL 1e-14 plus |δλ|/λ ≤ 1e-12
     assert res.max() <= 5e-12
     # M-orthonormal; close roots (relative gaps down to 1e-8 in the follower cluster)
-    # are Rayleigh–Ritz-ed together, so the Gram matrix is I to ~1e-8
-    assert np.abs(V.T @ (M @ V) - np.eye(V.shape[1])).max() <= 1e-7
+    # are Rayleigh–Ritz-ed together, so the Gram matrix is I to ~1e-8..1e-7 (measured
+    # 1.1e-7 on 2 BLAS threads, N = 200 fixed-fixed). bound: vectors of roots iterated
+    # apart lose orthogonality by residual / relative gap (Davis–Kahan) <= 5e-12 / 1e-8
+    # = 5e-4; the joint Ritz step keeps it far below; 1e-6 catches a lost Ritz step
+    assert np.abs(V.T @ (M @ V) - np.eye(V.shape[1])).max() <= 1e-6
 
 
 def test_assembled_modes_reference_paths():
