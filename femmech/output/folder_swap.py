@@ -234,13 +234,15 @@ def _free_name(path: Path) -> Path:
     return candidate
 
 
-def retire(old: Path, out: Path, ours: set[str], recovered: str = "") -> bool:
+def retire(old: Path, out: Path, ours: set[str], recovered: str = "",
+           quiet: bool = False) -> bool:
     """Move the user's files from the previous folder ``old`` into ``out`` at the same
     relative places, then remove ``old``; True if it is gone. It is kept (and named in a
     warning) if a file could not be moved. Warns naming the files carried into femmech's
     subfolders and those renamed because the new run wrote the same name, after the note
-    ``recovered`` (the recovery of a killed run) if given."""
-    nested, renamed, stuck = [], [], []
+    ``recovered`` (the recovery of a killed run) if given (if ``quiet``, only when a
+    user file was there)."""
+    nested, renamed, stuck, moved = [], [], [], 0
     for rel in user_items(old, ours):
         target = _free_name(out / rel)
         try:
@@ -249,13 +251,14 @@ def retire(old: Path, out: Path, ours: set[str], recovered: str = "") -> bool:
         except OSError:
             stuck.append(rel)
             continue
+        moved += 1
         if target != out / rel:
             renamed.append(f"{rel} -> {target.relative_to(out).as_posix()}")
         elif "/" in rel:
             nested.append(rel)
     if not stuck:
         shutil.rmtree(old, ignore_errors=True)
-    notes = [recovered] if recovered else []
+    notes = [recovered] if recovered and (moved or stuck or not quiet) else []
     if nested:
         notes.append(f"kept your files inside femmech's subfolders: {_listed(nested)}")
     if renamed:
@@ -343,7 +346,7 @@ def _recover_run(out: Path, token: str) -> None:
             retire(old, out, ours, f"a run (process {pid}) killed during its swap left the"
                                    f" previous folder as {old.name}; your files still"
                                    " there were moved into the folder (interrupted swap"
-                                   " recovered)")
+                                   " recovered)", quiet=True)
     if new.is_dir() and not new.is_symlink():
         shutil.rmtree(new, ignore_errors=True)
     sibling(out, "jtmp", token).unlink(missing_ok=True)
