@@ -134,8 +134,10 @@ def test_a_run_killed_at_rename_k_loses_nothing_and_the_rerun_recovers(tmp_path,
     if seen is None:
         assert not recovery, messages
     else:
-        assert len(recovery) == 1 and seen in recovery[0], messages
-        assert ".out.femmech-old-" in recovery[0] and "killed" in recovery[0]
+        assert len(recovery) == 1, messages
+        assert seen in recovery[0], messages
+        assert ".out.femmech-old-" in recovery[0]
+        assert "killed" in recovery[0]
 
 
 def _aside(tmp_path: Path, pid: int, journal: bool) -> Path:
@@ -180,7 +182,8 @@ def test_the_previous_folder_of_a_run_that_holds_its_lock_is_left_alone(tmp_path
         os.close(fd)
     # its lock released (the run died, pid 1 still runs): the next run recovers
     messages = _rerun(tmp_path / "out")
-    assert len(messages) == 1 and "interrupted swap recovered" in messages[0], messages
+    assert len(messages) == 1, messages
+    assert "interrupted swap recovered" in messages[0]
     for rel, text in USER.items():
         assert (tmp_path / "out" / rel).read_text() == text
     assert not [p.name for p in tmp_path.iterdir() if ".femmech-" in p.name]

@@ -41,7 +41,7 @@ from pathlib import Path
 
 from filelock import FileLock, Timeout
 
-from femmech.errors import CacheWarning, FileFormatError
+from femmech.errors import CacheWarning
 from femmech.output.export import atomic_path
 from femmech.reduction.superelement import FORMAT_VERSION, Superelement
 from femmech.reduction.superelement_archive import open_regular, read_regular
@@ -101,13 +101,13 @@ def _sha256_file(path: Path, size: int | None = None) -> str:
     with open_regular(path, "cache entry", follow_links=False) as stream:
         found = os.fstat(stream.fileno()).st_size
         if size is not None and found != size:
-            raise _SizeMismatch(f"size {found} bytes, manifest says {size} (truncated?)")
+            raise _SizeMismatchError(f"size {found} bytes, manifest says {size} (truncated?)")
         for block in iter(lambda: stream.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()
 
 
-class _SizeMismatch(Exception):
+class _SizeMismatchError(Exception):
     """The entry's size (of the open file) differs from its manifest's."""
 
 
@@ -138,7 +138,7 @@ def read_entry(folder, key: str) -> tuple[Superelement | None, str | None]:
             digest = _sha256_file(data_path, size)
         except FileNotFoundError:
             return None, "superelement file missing"
-        except _SizeMismatch as exc:
+        except _SizeMismatchError as exc:
             return None, str(exc)
         if digest != manifest.get("sha256"):
             return None, "checksum mismatch"
