@@ -118,7 +118,7 @@ def open_regular(path, what: str = "superelement file", follow_links: bool = Tru
         _require_regular(info, path, file, what)
         if max_bytes is not None and info.st_size > max_bytes:
             raise FileFormatError(f"{file}: not a readable {what}: it has {info.st_size}"
-                                  f" bytes, more than the {max_bytes} a {what} may have")
+                                  f" bytes, more than {_a(what)} may have ({max_bytes})")
         if hasattr(os, "set_blocking"):
             os.set_blocking(fd, True)
         return os.fdopen(fd, "rb")
@@ -133,8 +133,8 @@ def read_regular(path, what: str, max_bytes: int, follow_links: bool = False) ->
     with open_regular(path, what, follow_links, max_bytes) as stream:
         data = stream.read(max_bytes + 1)
     if len(data) > max_bytes:
-        raise FileFormatError(f"{_name(path)}: not a readable {what}: it has more than"
-                              f" {max_bytes} bytes, the most a {what} may have")
+        raise FileFormatError(f"{_name(path)}: not a readable {what}: it grew to more"
+                              f" than {_a(what)} may have ({max_bytes} bytes) while read")
     return data
 
 
@@ -157,10 +157,14 @@ def _no_regular(path, file: str, what: str, kind: str) -> FileFormatError:
         except OSError:
             pass
         return FileFormatError(f"{file}: not a readable {what}: it is {kind}, not a regular"
-                               f" file; femmech does not follow links in the place of a"
-                               f" {what}")
+                               f" file; femmech does not follow links in the place of"
+                               f" {_a(what)}")
     return FileFormatError(f"{file}: not a readable {what}: it is {kind}, not a"
-                           f" regular file; a {what} must be a regular file")
+                           f" regular file; {_a(what)} must be a regular file")
+
+
+def _a(what: str) -> str:
+    return ("an " if what[:1] in "aeiou" else "a ") + what
 
 
 MAX_HEADER = 10_000

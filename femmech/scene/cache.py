@@ -101,7 +101,8 @@ def _sha256_file(path: Path, size: int | None = None) -> str:
     with open_regular(path, "cache entry", follow_links=False) as stream:
         found = os.fstat(stream.fileno()).st_size
         if size is not None and found != size:
-            raise _SizeMismatchError(f"size {found} bytes, manifest says {size} (truncated?)")
+            raise _SizeMismatchError(f"size {found} bytes, manifest says {size}"
+                                     f" ({'truncated' if found < size else 'appended to'}?)")
         for block in iter(lambda: stream.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()
