@@ -11,12 +11,15 @@ own subfolders (e.g. ``modes_steps/``), is the user's and is carried over into t
 folder at the same place (a FemmechWarning names those inside femmech's subfolders, and
 any that had to be renamed because the new run wrote a file of the same name). A failed
 or interrupted run leaves the previous folder as it was; its staging folder is removed at
-once, or by the next run into the same folder if the process was killed (a previous
-folder retired by a run killed during the swap is put back, or its user files carried
-over). A folder that is neither empty nor written by femmech is refused, so ``--out`` can
+once, or by the next run into the same folder if the process was killed. The swap itself
+is crash-safe (:mod:`.folder_swap`: a run lock decides whether a run still runs, a journal
+what a killed swap had done): the next run completes or undoes it and never removes a
+folder holding a user's file. A folder that is neither empty nor written by femmech (its
+manifest missing, or no regular file: a link, FIFO, device, directory or larger than
+:data:`~femmech.output.folder_swap.MAX_MANIFEST_BYTES`) is refused, so ``--out`` can
 never make femmech delete a user's files.
 
-Stage 7 (output): uses only errors.
+Stage 7 (output): uses errors and :mod:`.folder_swap`.
 """
 
 from __future__ import annotations
