@@ -114,7 +114,10 @@ def hold_lock(path: Path) -> int | None:
     if fcntl is None:
         return None
     for _ in range(10):
-        fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o644)
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o644)
+        except OSError:  # a read-only parent fails later, with its own message
+            return None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             if os.path.samestat(os.fstat(fd), os.stat(path)):
@@ -328,8 +331,9 @@ def _recover_run(out: Path, token: str) -> None:
     old, new = sibling(out, "old", token), sibling(out, "new", token)
     pid = token.split("-")[0]
     journal = _read_journal(sibling(out, "journal", token))
-    ours = journal if journal is not None else (run_files(old) if old.is_dir() else set())
-    if old.is_dir():
+    aside = old.is_dir() and not old.is_symlink()
+    ours = journal if journal is not None else (run_files(old) if aside else set())
+    if aside:
         if not os.path.lexists(out) and new.is_dir() and journal is not None \
                 and (new / MANIFEST).is_file():
             os.rename(new, out)
