@@ -115,7 +115,8 @@ def test_previous_folder_retired_by_a_killed_swap_is_put_back_or_carried_over(tm
     dead = 2 ** 22 + 12345  # above the default pid_max (2^22): no such process
     retired = tmp_path / f".out.femmech-old-{dead}-abcd1234"
     os.rename(out, retired)
-    with pytest.warns(FemmechWarning, match="modes_steps/mine.txt"):
+    with pytest.warns(FemmechWarning, match="is put back"), \
+            pytest.warns(FemmechWarning, match="modes_steps/mine.txt"):
         _run(out, {"report.html": "r2"})
     assert (out / "modes_steps" / "mine.txt").read_text() == "mine"
     assert _hidden(tmp_path) == []
@@ -124,7 +125,33 @@ def test_previous_folder_retired_by_a_killed_swap_is_put_back_or_carried_over(tm
     (retired / MANIFEST).write_text(json.dumps({"by": "femmech", "files": ["old.csv"]}))
     (retired / "old.csv").write_text("femmech's")
     (retired / "precious.txt").write_text("mine")
-    _run(out, {"report.html": "r3"})
+    with pytest.warns(FemmechWarning, match="interrupted swap recovered"):
+        _run(out, {"report.html": "r3"})
     assert (out / "precious.txt").read_text() == "mine"
     assert not (out / "old.csv").exists()
     assert _hidden(tmp_path) == []
+
+
+def test_a_swap_that_fails_in_the_process_puts_the_previous_folder_back(tmp_path, monkeypatch):
+    """A rename of the swap that fails (here: putting the new results in place, as on a
+    full or read-only disk) puts the previous folder back at once, before the error
+    propagates; a later run in the same process then replaces it as usual."""
+    out = tmp_path / "out"
+    _run(out, RUN)
+    (out / "mine.txt").write_text("mine")
+    before = _tree(out)
+    real = os.rename
+
+    def failing(src, dst):
+        if Path(src).name.startswith(".out.femmech-new-"):
+            raise OSError(28, "No space left on device")
+        real(src, dst)
+
+    monkeypatch.setattr(os, "rename", failing)
+    with pytest.raises(OSError, match="No space left"):
+        _run(out, {"report.html": "r2"})
+    monkeypatch.setattr(os, "rename", real)
+    assert _tree(out) == before
+    assert _hidden(tmp_path) == []
+    _run(out, {"report.html": "r3"})
+    assert _tree(out) == {"report.html": "r3", "mine.txt": "mine"}

@@ -19,7 +19,8 @@ does not import pyvista.
 * :mod:`.histories`: time histories and orbits of a forced response (PNG, CSV).
 * :mod:`.tables`: frequency tables of a mode set (text, CSV).
 * :mod:`.report`: one self-contained HTML report page.
-* :mod:`.folder`: one run, one output folder (staging folder and manifest).
+* :mod:`.folder`: one run, one output folder (staging folder and manifest);
+  :mod:`.folder_swap`: its crash-safe swap (run lock, journal, recovery of killed runs).
 
 Stage 7 (output): uses analysis, coupling, reduction, fe and errors; of femmech only
 :mod:`femmech.scene` imports it.

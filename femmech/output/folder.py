@@ -11,93 +11,44 @@ own subfolders (e.g. ``modes_steps/``), is the user's and is carried over into t
 folder at the same place (a FemmechWarning names those inside femmech's subfolders, and
 any that had to be renamed because the new run wrote a file of the same name). A failed
 or interrupted run leaves the previous folder as it was; its staging folder is removed at
-once, or by the next run into the same folder if the process was killed (a previous
-folder retired by a run killed during the swap is put back, or its user files carried
-over). A folder that is neither empty nor written by femmech is refused, so ``--out`` can
+once, or by the next run into the same folder if the process was killed. The swap itself
+is crash-safe (:mod:`.folder_swap`: a run lock decides whether a run still runs, a journal
+what a killed swap had done): the next run completes or undoes it and never removes a
+folder holding a user's file. A folder that is neither empty nor written by femmech (its
+manifest missing, or no regular file: a link, FIFO, device, directory or larger than
+:data:`~femmech.output.folder_swap.MAX_MANIFEST_BYTES`) is refused, so ``--out`` can
 never make femmech delete a user's files.
 
-Stage 7 (output): uses only errors.
+Stage 7 (output): uses errors and :mod:`.folder_swap`.
 """
 
 from __future__ import annotations
 
 import json
 import os
-import secrets
 import shutil
-import time
-import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from femmech.errors import FemmechWarning, InputError
+from femmech.errors import InputError
+from femmech.output.folder_swap import (
+    MANIFEST,
+    STALE_AGE,
+    hold_lock,
+    manifest_problem,
+    new_token,
+    read_manifest,
+    recover,
+    release_lock,
+    run_files,
+    sibling,
+    swap,
+    user_items,
+)
 
-MANIFEST = ".femmech-run.json"
-"""File name of the manifest in an output folder: ``{"files": [...], "by": "femmech"}``."""
-
-_TAG = ".femmech-"
-
-STALE_AGE = 24 * 3600.0
-"""s; where a process cannot be asked whether it still runs (Windows, where signal 0 is
-Ctrl-C), a staging folder older than this counts as left by a killed run."""
-
-
-def _siblings(out: Path) -> list[Path]:
-    """Staging and retired folders of ``out`` left by earlier runs."""
-    prefix = f".{out.name}{_TAG}"
-    return [p for p in out.parent.iterdir() if p.name.startswith(prefix)]
-
-
-def _alive(pid: int, path: Path) -> bool:
-    """Whether the run that made ``path`` may still be running."""
-    if os.name == "nt":  # os.kill(pid, 0) would send CTRL_C_EVENT there
-        try:
-            return time.time() - path.stat().st_mtime < STALE_AGE
-        except OSError:
-            return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except OSError:  # e.g. another user's process: leave its folder alone
-        return True
-    return True
-
-
-def _remove_stale(out: Path) -> None:
-    """Clear the staging/retired siblings of ``out`` whose process no longer runs: staging
-    folders are removed; a retired folder (the previous run, moved aside by a run killed
-    during the swap) is put back if ``out`` is missing, else its user files are carried
-    over into ``out`` before it is removed."""
-    for path in _siblings(out):
-        try:
-            pid = int(path.name.rsplit("-", 2)[-2])
-        except (ValueError, IndexError):
-            continue
-        if pid == os.getpid() or _alive(pid, path):
-            continue
-        if path.name.startswith(f".{out.name}{_TAG}old-"):
-            if not os.path.lexists(out):
-                os.rename(path, out)
-                continue
-            _retire(path, out, _ours(path))
-        else:
-            shutil.rmtree(path, ignore_errors=True)
-
-
-def read_manifest(folder: Path) -> list[str] | None:
-    """Relative paths listed in ``folder``'s manifest; None if it has no valid one."""
-    try:
-        data = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    if not isinstance(data, dict) or data.get("by") != "femmech":
-        return None
-    files = data.get("files")
-    if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
-        return None
-    return files
+__all__ = ["MANIFEST", "STALE_AGE", "check_output_folder", "output_path", "read_manifest",
+           "real_output_path", "staged_output"]
 
 
 def output_path(out) -> Path:
@@ -122,10 +73,13 @@ def check_output_folder(out) -> Path:
     out = real_output_path(out)
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out}: exists and is not a folder")
-    if out.is_dir() and any(out.iterdir()) and read_manifest(out) is None:
-        raise InputError(f"--out {out}: the folder is not empty and was not written by femmech"
-                         f" (no {MANIFEST}); give a new or empty folder (femmech replaces the"
-                         " files of its previous run there, and never touches others)")
+    if out.is_dir() and any(out.iterdir()):
+        problem = manifest_problem(out)
+        if problem is not None:
+            raise InputError(f"--out {out}: the folder is not empty and was not written by"
+                             f" femmech ({problem}); give a new or empty folder (femmech"
+                             " replaces the files of its previous run there, and never"
+                             " touches others)")
     return out
 
 
@@ -150,19 +104,24 @@ def staged_output(out) -> Iterator[Path]:
     OSError
         The parent folder cannot be created or written.
     """
-    out = check_output_folder(out)
+    out = real_output_path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    _remove_stale(out)
-    token = f"{os.getpid()}-{secrets.token_hex(4)}"
-    staging = out.parent / f".{out.name}{_TAG}new-{token}"
-    staging.mkdir()
+    recover(out)  # killed runs into out: their swaps finished or undone first
+    out = check_output_folder(out)
+    token = new_token()
+    lock = hold_lock(sibling(out, "lock", token))
+    staging = sibling(out, "new", token)
     try:
-        yield staging
-        _write_manifest(staging)
-        _replace(out, staging, token)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
+        staging.mkdir()
+        try:
+            yield staging
+            _write_manifest(staging)
+            _replace(out, staging, token)
+        except BaseException:
+            shutil.rmtree(staging, ignore_errors=True)
+            raise
+    finally:
+        release_lock(out, token, lock)
 
 
 def _write_manifest(staging: Path) -> None:
@@ -176,77 +135,8 @@ def _replace(out: Path, staging: Path, token: str) -> None:
     if not out.exists():
         os.rename(staging, out)
         return
-    ours = _ours(out)
-    retired = out.parent / f".{out.name}{_TAG}old-{token}"
-    os.rename(out, retired)
-    os.rename(staging, out)
-    _retire(retired, out, ours)
-
-
-def _ours(folder: Path) -> set[str]:
-    """Relative paths (POSIX) of the files femmech wrote into ``folder``: its manifest's."""
-    return set(read_manifest(folder) or ()) | {MANIFEST}
-
-
-def _user_items(folder: Path, ours: set[str], parents: set[str], rel: str = ""):
-    """Relative paths under ``folder`` that femmech did not write: files (and links) not
-    in ``ours``, and whole folders that hold none of ``ours`` (``parents``: the folders
-    that do)."""
-    for item in sorted(folder.iterdir()):
-        path = rel + item.name
-        if path in ours:
-            continue
-        if path in parents and item.is_dir() and not item.is_symlink():
-            yield from _user_items(item, ours, parents, path + "/")
-        else:
-            yield path
-
-
-def _free_name(path: Path) -> Path:
-    """``path``, or ``<stem>.kept<suffix>`` (``.kept2``, ...) if that name is taken."""
-    candidate, n = path, 1
-    while os.path.lexists(candidate):
-        candidate = path.with_name(f"{path.stem}.kept{n if n > 1 else ''}{path.suffix}")
-        n += 1
-    return candidate
-
-
-def _retire(retired: Path, out: Path, ours: set[str]) -> None:
-    """Move the user's files from the previous folder ``retired`` into ``out`` at the same
-    relative places, then remove ``retired``; kept (and named in a warning) if a file
-    could not be moved. Warns naming the files carried into femmech's subfolders and
-    those renamed because the new run wrote the same name."""
-    parents = {"/".join(f.split("/")[:i]) for f in ours for i in range(1, f.count("/") + 1)}
-    nested, renamed, stuck = [], [], []
-    for rel in _user_items(retired, ours, parents):
-        target = _free_name(out / rel)
-        try:
-            target.parent.mkdir(parents=True, exist_ok=True)
-            os.rename(retired / rel, target)
-        except OSError:
-            stuck.append(rel)
-            continue
-        if target != out / rel:
-            renamed.append(f"{rel} -> {target.relative_to(out).as_posix()}")
-        elif "/" in rel:
-            nested.append(rel)
-    if not stuck:
-        shutil.rmtree(retired, ignore_errors=True)
-    notes = []
-    if nested:
-        notes.append(f"kept your files inside femmech's subfolders: {_listed(nested)}")
-    if renamed:
-        notes.append(f"the new run wrote files of the same names as yours, kept as:"
-                     f" {_listed(renamed)}")
-    if stuck:
-        notes.append(f"could not move {_listed(stuck)}; the previous folder is left as"
-                     f" {retired}")
-    if notes:
-        # stacklevel 5: past _replace or _remove_stale, staged_output and contextlib, to
-        # the with statement of the caller
-        warnings.warn(FemmechWarning(f"--out {out}: " + "; ".join(notes)), stacklevel=5)
-
-
+    ours = run_files(out)
+    swap(out, staging, token, ours, list(user_items(out, ours)))
 def _listed(paths: list[str], at_most: int = 10) -> str:
     more = len(paths) - at_most
     return ", ".join(paths[:at_most]) + (f" and {more} more" if more > 0 else "")

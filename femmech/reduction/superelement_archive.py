@@ -66,34 +66,59 @@ _KINDS = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character de
           (stat.S_ISSOCK, "a socket"))
 
 
-def open_regular(path, what: str = "superelement file"):
-    """Open ``path`` for binary reading if it is a regular file (after symlinks).
+def open_regular(path, what: str = "superelement file", follow_links: bool = True,
+                 max_bytes: int | None = None):
+    """Open ``path`` for binary reading if it is a regular file.
 
-    The kind is checked before the file is opened (``os.stat``) and again on the open
-    descriptor (``os.fstat``, against a swap in between); the open does not block
-    (``O_NONBLOCK``: a FIFO without a writer would wait forever, a read of ``/dev/zero``
-    never ends).
+    The kind is checked before the file is opened (``os.stat``, or ``os.lstat`` if not
+    ``follow_links``) and again on the open descriptor (``os.fstat``, against a swap in
+    between); the open does not block (``O_NONBLOCK``: a FIFO without a writer would wait
+    forever, a read of ``/dev/zero`` never ends) and, if not ``follow_links``, does not
+    follow a symbolic link (``O_NOFOLLOW`` where the system has it).
+
+    Parameters
+    ----------
+    path : path
+    what : str
+        What the file should be, for the messages (``"cache manifest"``).
+    follow_links : bool
+        False: a symbolic link in the place of the file is refused (femmech's own files:
+        cache entries, output-folder manifests); True: a link to a regular file is read
+        (files the user names).
+    max_bytes : int, optional
+        Largest size accepted, bytes (from ``fstat`` of the open file, before any read);
+        callers read at most this much.
 
     Raises
     ------
     FileNotFoundError
         If there is no file ``path``.
     FileFormatError
-        One line naming the file and what it is instead (FIFO, device, directory,
-        socket; a symbolic link's target), or why it cannot be opened.
+        One line ``<path>: not a readable <what>: ...`` naming what it is instead (FIFO,
+        device, directory, socket, symbolic link; a followed link's target), that it is
+        larger than ``max_bytes``, or why it cannot be opened.
     """
     file = _name(path)
+    flags = (os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
+             | getattr(os, "O_BINARY", 0))
+    if not follow_links:
+        flags |= getattr(os, "O_NOFOLLOW", 0)
     try:
-        _require_regular(os.stat(path), path, file, what)
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0)
-                     | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_BINARY", 0))
+        _require_regular((os.stat if follow_links else os.lstat)(path), path, file, what)
+        fd = os.open(path, flags)
     except (FileNotFoundError, FileFormatError):
         raise
     except OSError as exc:
+        if not follow_links and os.path.islink(path):  # ELOOP: swapped for a link meanwhile
+            raise _no_regular(path, file, what, "a symbolic link") from None
         raise FileFormatError(f"{file}: cannot open the {what}: {type(exc).__name__}:"
                               f" {exc.strerror or exc}") from exc
     try:
-        _require_regular(os.fstat(fd), path, file, what)
+        info = os.fstat(fd)
+        _require_regular(info, path, file, what)
+        if max_bytes is not None and info.st_size > max_bytes:
+            raise FileFormatError(f"{file}: not a readable {what}: it has {info.st_size}"
+                                  f" bytes, more than {_a(what)} may have ({max_bytes})")
         if hasattr(os, "set_blocking"):
             os.set_blocking(fd, True)
         return os.fdopen(fd, "rb")
@@ -102,15 +127,44 @@ def open_regular(path, what: str = "superelement file"):
         raise
 
 
+def read_regular(path, what: str, max_bytes: int, follow_links: bool = False) -> bytes:
+    """The bytes of the regular file ``path`` of at most ``max_bytes`` bytes
+    (:func:`open_regular`; a file that grows while read is refused too)."""
+    with open_regular(path, what, follow_links, max_bytes) as stream:
+        data = stream.read(max_bytes + 1)
+    if len(data) > max_bytes:
+        raise FileFormatError(f"{_name(path)}: not a readable {what}: it grew to more"
+                              f" than {_a(what)} may have ({max_bytes} bytes) while read")
+    return data
+
+
 def _require_regular(info: os.stat_result, path, file: str, what: str) -> None:
     if stat.S_ISREG(info.st_mode):
         return
+    if stat.S_ISLNK(info.st_mode):  # only from lstat: a link that is not followed
+        raise _no_regular(path, file, what, "a symbolic link")
     kind = next((text for test, text in _KINDS if test(info.st_mode)), "not a regular file")
     link = ""
     if os.path.islink(path):
         link = f" (a symbolic link to {_name(os.path.realpath(path))})"
-    raise FileFormatError(f"{file}: not a readable {what}: it is {kind}{link}, not a"
-                          f" regular file; a {what} must be a regular file")
+    raise _no_regular(path, file, what, kind + link)
+
+
+def _no_regular(path, file: str, what: str, kind: str) -> FileFormatError:
+    if kind == "a symbolic link":
+        try:
+            kind += f" to {_name(os.readlink(path))}"
+        except OSError:
+            pass
+        return FileFormatError(f"{file}: not a readable {what}: it is {kind}, not a regular"
+                               f" file; femmech does not follow links in the place of"
+                               f" {_a(what)}")
+    return FileFormatError(f"{file}: not a readable {what}: it is {kind}, not a"
+                           f" regular file; {_a(what)} must be a regular file")
+
+
+def _a(what: str) -> str:
+    return ("an " if what[:1] in "aeiou" else "a ") + what
 
 
 MAX_HEADER = 10_000

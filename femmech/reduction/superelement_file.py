@@ -124,7 +124,9 @@ def read(path) -> dict:
         One line naming the file and the field, if the file is not a valid superelement
         file (truncated, damaged, foreign, crafted, or of another format version), or
         naming the file if it is no regular file (a FIFO, a device such as a link to
-        ``/dev/zero``, a directory: refused before it is opened for reading).
+        ``/dev/zero``, a directory: refused before it is opened for reading). A symbolic
+        link to a regular file is read: the user named it (cache entries, which femmech
+        names itself, refuse links: :func:`femmech.scene.cache.read_entry`).
     """
     file = _name(path)
     with open_regular(path) as stream:

@@ -41,10 +41,10 @@ from pathlib import Path
 
 from filelock import FileLock, Timeout
 
-from femmech.errors import CacheWarning, FileFormatError
+from femmech.errors import CacheWarning
 from femmech.output.export import atomic_path
 from femmech.reduction.superelement import FORMAT_VERSION, Superelement
-from femmech.reduction.superelement_archive import open_regular
+from femmech.reduction.superelement_archive import open_regular, read_regular
 from femmech.scene.cache_folder import (
     _evict,
     _remove,
@@ -93,35 +93,55 @@ MAX_MANIFEST = 1 << 20
 """Largest manifest read, bytes (a manifest holds a few hundred)."""
 
 
-def _sha256_file(path: Path) -> str:
+def _sha256_file(path: Path, size: int | None = None) -> str:
+    """SHA-256 hex of the cache entry ``path``, a regular file (not a link to one) of
+    ``size`` bytes if given (else FileFormatError naming the sizes). A FIFO, a device, a
+    directory or a link in its place: FileFormatError (:func:`open_regular`)."""
     digest = hashlib.sha256()
-    with open_regular(path, "cache entry") as stream:  # a FIFO or a device: FileFormatError
+    with open_regular(path, "cache entry", follow_links=False) as stream:
+        found = os.fstat(stream.fileno()).st_size
+        if size is not None and found != size:
+            raise _SizeMismatchError(f"size {found} bytes, manifest says {size}"
+                                     f" ({'truncated' if found < size else 'appended to'}?)")
         for block in iter(lambda: stream.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()
 
 
+class _SizeMismatchError(Exception):
+    """The entry's size (of the open file) differs from its manifest's."""
+
+
 def read_entry(folder, key: str) -> tuple[Superelement | None, str | None]:
     """``(superelement, None)`` for a valid entry, ``(None, None)`` if there is none and
-    ``(None, reason)`` if it is incomplete, truncated, corrupt, foreign or unreadable."""
+    ``(None, reason)`` if it is incomplete, truncated, corrupt, foreign or unreadable.
+
+    Both files must be regular files, not symbolic links (a link in the cache folder
+    could point anywhere; the folder itself may be a link): anything else is a damaged
+    entry, read no further than the manifest's :data:`MAX_MANIFEST` bytes and the size
+    the manifest gives."""
     data_path, manifest_path = entry_paths(folder, key)
     try:
-        if not data_path.exists() and not manifest_path.exists():
+        if not os.path.lexists(data_path) and not os.path.lexists(manifest_path):
             return None, None
         try:
             manifest = json.loads(_read_manifest(manifest_path))
         except FileNotFoundError:
             return None, "no manifest (interrupted write)"
-        except ValueError as exc:  # FileFormatError too: a FIFO, a device, too large
+        except ValueError as exc:  # FileFormatError too: a FIFO, a device, a link, too large
             return None, f"unreadable manifest ({_why(exc)})"
         if not isinstance(manifest, dict) or manifest.get("key") != key:
             return None, "manifest of another entry (foreign)"
-        if not data_path.exists():
+        size = manifest.get("size")
+        if not isinstance(size, int) or isinstance(size, bool):
+            return None, f"unreadable manifest (size {size!r}, expected bytes)"
+        try:
+            digest = _sha256_file(data_path, size)
+        except FileNotFoundError:
             return None, "superelement file missing"
-        size = data_path.stat().st_size
-        if size != manifest.get("size"):
-            return None, f"size {size} bytes, manifest says {manifest.get('size')} (truncated?)"
-        if _sha256_file(data_path) != manifest.get("sha256"):
+        except _SizeMismatchError as exc:
+            return None, str(exc)
+        if digest != manifest.get("sha256"):
             return None, "checksum mismatch"
         return Superelement.load(data_path), None
     except OSError as exc:
@@ -131,12 +151,9 @@ def read_entry(folder, key: str) -> tuple[Superelement | None, str | None]:
 
 
 def _read_manifest(path: Path) -> str:
-    """The manifest's text, from a regular file of at most :data:`MAX_MANIFEST` bytes."""
-    with open_regular(path, "cache manifest") as stream:
-        data = stream.read(MAX_MANIFEST + 1)
-    if len(data) > MAX_MANIFEST:
-        raise FileFormatError(f"{path}: more than {MAX_MANIFEST} bytes, not a cache manifest")
-    return data.decode("utf-8")
+    """The manifest's text, from a regular file (no link) of at most :data:`MAX_MANIFEST`
+    bytes."""
+    return read_regular(path, "cache manifest", MAX_MANIFEST).decode("utf-8")
 
 
 def write_entry(folder, key: str, se: Superelement, label: str) -> Path:
