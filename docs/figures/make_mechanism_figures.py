@@ -40,8 +40,10 @@ def _spring(ax, p0, p1, label="", n=6, width=0.12, side=1.0):
                                  * (k < 2 * n) for k, si in enumerate(s)] + [p0 + 0.8 * d, p1]
     ax.plot(*np.array(zig).T, color="k", lw=1.2)
     if label:
-        m = p0 + 0.5 * d + side * (width + 0.14) * nrm
-        ax.text(*m, label, fontsize=FONT, ha="center", va="center")
+        out = side * nrm
+        m = p0 + 0.5 * d + (width + 0.08) * out
+        ha = "left" if out[0] > 0.5 else "right" if out[0] < -0.5 else "center"
+        ax.text(*m, label, fontsize=FONT, ha=ha, va="center")
     return t
 
 
@@ -152,7 +154,7 @@ def cam_follower():
     _mass(ax, (0.0, 2.2), 0.8, 0.6, "m")
     _arrow(ax, (0.55, 1.95), (0, 0.5), "y = y_c + U(ψ) + q")
     _arrow(ax, (-0.85, 1.1), (0, 0.45), "q", offset=(-0.08, 0), ha="right")
-    _spring(ax, (0.0, 2.5), (0.0, 3.3), "c_r (return)", width=0.1, side=-3.2)
+    _spring(ax, (0.0, 2.5), (0.0, 3.3), "c_r (return)", width=0.1, side=-1.0)
     _ground(ax, (0.0, 3.3), angle=np.pi)
     _arrow(ax, (0.45, 3.25), (0, 0.4), "y_f (spring base)")
     _arrow(ax, (-0.6, 2.45), (0, -0.45), "F", color=RED, offset=(-0.08, 0), ha="right")
@@ -209,8 +211,9 @@ def _output_chain(ax, x, y, mass, spring, damper, force, coord, label=None):
     _damper(ax, (x - 0.4, y), (x - 0.4, y + 0.8), damper, side=1.6)
     _mass(ax, (x - 0.2, y + 1.05), 0.8, 0.5, mass)
     _arrow(ax, (x + 0.35, y + 0.85), (0, 0.45), coord)
-    _arrow(ax, (x - 0.45, y + 1.75), (0, -0.45), force, color=RED, offset=(-0.06, 0.1),
-           ha="right")
+    if force:
+        _arrow(ax, (x - 0.45, y + 1.75), (0, -0.45), force, color=RED, offset=(-0.06, 0.1),
+               ha="right")
     return y + 1.3
 
 
@@ -231,16 +234,34 @@ def table_5_1(case: int):
         ax.plot([0.06, x], [0.0, 0.0], color=GREY, lw=2)
         ax.plot([x, x], [0.0, 0.3], color=GREY, lw=1.5)
         n = i + 2
-        top = _output_chain(ax, x + 0.2, 0.7, f"m{n}", f"c{n}", f"b{n}", f"F{n}",
+        force = "" if case == 2 else f"F{n}"   # case 2 has F3 only
+        top = _output_chain(ax, x + 0.2, 0.7, f"m{n}", f"c{n}", f"b{n}", force,
                             f"x{n} = U{'' if case != 3 else n}(ψ) + q{n}")
-    if case == 1:
-        ax.texts[-2].set_text("x2 = U(ψ) + q2")
     if case == 2:
-        ax.texts[-1].set_visible(False)     # F2 is not a parameter of case 2
         top = _output_chain(ax, 1.1, top + 0.1, "m3", "c3", "b3", "F3", "x3 = U(ψ) + q3")
     ax.set_xlim(-3.6, 4.6 if case != 3 else 6.0)
     ax.set_ylim(-0.9, top + 0.7)
     _save(fig, f"table_5_1_case_{case}.png")
+
+
+def follower_unit():
+    fig, ax = _new(6.8, 4.8, "follower_unit: one unit of a chain (the chain's shaft at its"
+                             " node)")
+    _shaft(ax, -2.4, 2.4, 0.0, [(0.0, "inertia")], [(-2.3, -0.1, "shaft (chain)"),
+                                                     (0.1, 2.3, "shaft (chain)")],
+           (), [(0.0, "ψ = φ + δ_u + q1")])
+    ax.add_patch(Rectangle((0.6, 0.3), 0.6, 0.4, fc="#f3e2c7", ec="k", zorder=2))
+    ax.text(0.9, 0.5, "cam U", fontsize=FONT, ha="center", va="center")
+    ax.plot([0.06, 0.9], [0.0, 0.0], color=GREY, lw=2)
+    ax.plot([0.9, 0.9], [0.0, 0.3], color=GREY, lw=1.5)
+    top = _output_chain(ax, 1.1, 0.7, "mass", "stiffness", "damping", "force",
+                        "x2 = U(ψ) + q2")
+    _spring(ax, (0.9, top + 0.05), (0.9, top + 0.75), "c_g (ground_stiffness)", width=0.08,
+            side=-1.0)
+    _ground(ax, (0.9, top + 0.75), width=0.5, angle=np.pi)
+    ax.set_xlim(-3.0, 4.4)
+    ax.set_ylim(-1.0, top + 1.0)
+    _save(fig, "follower_unit.png")
 
 
 def table_5_1_case_4():
@@ -285,7 +306,7 @@ def processing_machine():
         ax.plot([x + 0.45, x + 0.45], [0.0, 0.45], color=GREY, lw=1.2)
         top = _output_chain(ax, x + 0.65, 0.8, m, c, b, F, f"y{k} = U{k}(φ{k}) + {q}")
         _spring(ax, (x + 0.45, top + 0.05), (x + 0.45, top + 0.75), f"{cr} (return)",
-                width=0.08, side=-3.5)
+                width=0.08, side=-1.0)
         _ground(ax, (x + 0.45, top + 0.75), width=0.5, angle=np.pi)
     ax.set_xlim(-3.8, 6.3)
     ax.set_ylim(-1.5, 3.8)
@@ -339,6 +360,7 @@ def main():
     for case in (1, 2, 3):
         table_5_1(case)
     table_5_1_case_4()
+    follower_unit()
     processing_machine()
     mobile_crane()
 

@@ -238,7 +238,7 @@ _MACHINES = (
 _CRANE_VALUES = "illustrative: mobile_crane_parameters()"
 _CRANE = Entry(
     "mobile_crane()", "Mobile crane with luffing cylinder and load pendulum",
-    'model = "mobile_crane", form = "second_kind"',
+    'model = "mobile_crane"  # drive events: form = "second_kind"',
     (Coordinate("q1", "chassis heave", "m", "y_S2 − y_20, + up"),
      Coordinate("q2", "chassis pitch", "rad",
                 "φ2, + counter-clockwise (x right, y up): the boom angle β = φ3 + q2 grows"),
@@ -286,7 +286,7 @@ _FOLLOWER_UNIT = Entry(
      Parameter("c_g", "spring from follower to ground (return spring) on x2", "N/m", "0",
                "ground_stiffness")),
     (Parameter("cam", "cam programme U(ψ) ([chain.unit.cam])", "m", "required", "cam"),),
-    drives=(), figure="table_5_1_case_1.png")
+    drives=(), figure="follower_unit.png")
 
 CATALOGUE: dict[str, Entry] = {e.call: e for e in (_CAM_FOLLOWER, _SLIDER_CRANK, *_CASES,
                                                    *_MACHINES, _CRANE, _FOLLOWER_UNIT)}
@@ -313,3 +313,50 @@ def describe(model, name: str, prefix: str = "") -> str:
     mechanism = getattr(model, "mechanism", model)
     meaning = dict(getattr(mechanism, "labels", ())).get(name, "")
     return readable(meaning, prefix + name)
+
+
+def _anchor(heading: str) -> str:
+    """GitHub's anchor of a heading (lower case, punctuation dropped, spaces to hyphens)."""
+    return "".join(ch for ch in heading.lower() if ch.isalnum() or ch in "_- ").replace(" ", "-")
+
+
+def _heading(entry: Entry) -> str:
+    return entry.title
+
+
+def _table(header: tuple, rows) -> list[str]:
+    return ["| " + " | ".join(header) + " |", "|" + "---|" * len(header),
+            *("| " + " | ".join(row) + " |" for row in rows)]
+
+
+def reference_markdown() -> str:
+    """The reference section of docs/mechanisms.md (between its ``mechanism-reference``
+    markers) rendered from :data:`CATALOGUE`: an index, then per mechanism its scene
+    spelling, figure and the tables of coordinates, parameters, position functions and
+    derived quantities. tests/test_mechanism_reference.py checks the page against it."""
+    entries = list(CATALOGUE.values())
+    lines = [f"- [{e.call}](#{_anchor(_heading(e))})" for e in entries] + [""]
+    for e in entries:
+        lines += [f"### {_heading(e)}", "", f"Python: `femmech.mechanisms.{e.call}`"
+                  if not e.call.startswith("follower_unit") else
+                  f"Python: `femmech.chain.{e.call}`", "",
+                  f"Scene file: `{e.scene}`" if e.scene.startswith(("model", "[")) else
+                  f"Scene file: {e.scene}", "",
+                  f"![{e.call}](figures/{e.figure})", ""]
+        lines += _table(("coordinate", "meaning", "unit", "sign convention"),
+                        ((f"`{c.name}`" + (" (drive)" if c.name in e.drives else ""),
+                          c.meaning, c.unit, c.sign) for c in e.coordinates)) + [""]
+        lines += _table(("parameter", "scene option", "meaning", "unit", "default"),
+                        ((f"`{p.name}`", f"`{p.option}`" if p.option else "–", p.meaning,
+                          p.unit, p.default) for p in e.parameters)) + [""]
+        if e.position_functions:
+            lines += _table(("position function", "scene option", "meaning", "unit",
+                             "default"),
+                            ((f"`{p.name}`", f"`{p.option}`" if p.option else "–",
+                              p.meaning, p.unit, p.default)
+                             for p in e.position_functions)) + [""]
+        if e.quantities:
+            lines += _table(("drive-event quantity", "meaning", "unit", "sign convention"),
+                            ((f"`{c.name}`", c.meaning, c.unit, c.sign)
+                             for c in e.quantities)) + [""]
+    return "\n".join(lines).rstrip() + "\n"
