@@ -158,7 +158,8 @@ def test_every_factory_and_scene_model_has_a_catalogue_entry():
         assert dict(mech.labels) == {c.name: c.meaning for c in entry.coordinates}, call
     for model in BUILTIN_MODELS:  # the scene spelling of each scene model
         entry = catalogue_entry(model, {"case": 1})
-        assert entry is not None and f'model = "{model}"' in entry.scene, model
+        assert entry is not None, model
+        assert f'model = "{model}"' in entry.scene, model
         assert entry.call in mechanisms
     assert set(CATALOGUE) - set(mechanisms) == {"follower_unit(cam, inertia, mass, stiffness)"}
 
