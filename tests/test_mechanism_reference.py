@@ -10,6 +10,7 @@ come from the same catalogue as the page.
 
 from __future__ import annotations
 
+import importlib.util
 import inspect
 import re
 from pathlib import Path
@@ -199,3 +200,22 @@ def test_readable_names_come_from_the_mechanism():
     # the scene's quantity descriptions follow the catalogue
     assert QUANTITIES["mobile_crane"]["q1"][0] == "chassis heave"
     assert QUANTITIES["slider_crank"]["v_g"][0] == "guide displacement across the slider axis"
+
+
+def test_the_chapter_symbol_table_agrees_with_the_catalogue():
+    # the page's older table of chapter symbols gives the same units as the reference
+    spec = importlib.util.spec_from_file_location(
+        "symbol_table", ROOT / "tests" / "mechanisms" / "test_gaps_symbol_table.py")
+    symbols = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(symbols)
+    calls = {"T5.1-1": "table_5_1_case(1)", "T5.1-2": "table_5_1_case(2)",
+             "T5.1-3": "table_5_1_case(3)", "T5.1-4": "table_5_1_case(4)",
+             "crane": "mobile_crane()", "machine": "processing_machine()",
+             "machine-mixed": "processing_machine_mixed()"}
+    rows = symbols._rows()
+    assert {model for model, *_ in rows} == set(calls)
+    for model, name, _, unit, _ in rows:
+        entry = CATALOGUE[calls[model]]
+        units = {x.name: x.unit for x in
+                 entry.coordinates + entry.parameters + entry.position_functions}
+        assert units.get(name) == unit, (model, name, unit, units.get(name))
