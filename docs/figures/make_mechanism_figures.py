@@ -226,7 +226,7 @@ def table_5_1(case: int):
     _shaft(ax, -2.6, 0.5, 0.0, [(0.0, "J1")], [(-2.5, -0.9, "c1")],
            [(-2.2, -1.2, "b1")], [(0.0, "ψ = θ + q1")])
     top = 0.0
-    xs = (0.9,) if case != 3 else (0.9, 3.6)
+    xs = (0.9,) if case != 3 else (0.9, 4.1)
     for i, x in enumerate(xs):
         ax.add_patch(Rectangle((x - 0.3, 0.3), 0.6, 0.4, fc="#f3e2c7", ec="k", zorder=2))
         ax.text(x, 0.5, "U" if case != 3 else f"U{i + 2}", fontsize=FONT, ha="center",
@@ -239,7 +239,7 @@ def table_5_1(case: int):
                             f"x{n} = U{'' if case != 3 else n}(ψ) + q{n}")
     if case == 2:
         top = _output_chain(ax, 1.1, top + 0.1, "m3", "c3", "b3", "F3", "x3 = U(ψ) + q3")
-    ax.set_xlim(-3.6, 4.6 if case != 3 else 6.0)
+    ax.set_xlim(-3.6, 4.6 if case != 3 else 6.5)
     ax.set_ylim(-0.9, top + 0.7)
     _save(fig, f"table_5_1_case_{case}.png")
 

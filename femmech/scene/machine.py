@@ -52,7 +52,8 @@ BUILTIN_MODELS = {"cam_follower": cam_follower, "slider_crank": slider_crank,
                   "mobile_crane": mobile_crane}
 """Built-in mechanism models by scene name → factory of :mod:`femmech.mechanisms`;
 ``options`` are the factory's keyword arguments (checked against its signature). To offer
-a new mechanism type in scenes, add its factory here (and its roles to ``_ROLE_KINDS``)."""
+a new mechanism type in scenes, add its factory here (and its roles to ``_ROLE_KINDS``; its
+coordinates and parameters to :data:`femmech.mechanisms.catalogue.CATALOGUE`)."""
 
 _ROLE_KINDS = {
     "cam_follower": {"m": ("m", MASS), "c": ("c", STIFFNESS), "c_return": ("c_r", STIFFNESS),
