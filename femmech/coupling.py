@@ -42,6 +42,7 @@ from femmech.errors import InputError
 from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
 from femmech.fe.model import FEModel, node_index
 from femmech.html import html_summary
+from femmech.mechanisms.catalogue import describe
 from femmech.reduction.substructures import Assembly
 from femmech.reduction.superelement import Superelement
 
@@ -151,6 +152,16 @@ class CoupledSystem:
     def n(self) -> int:
         """Number of global coordinates."""
         return self.M0.shape[0]
+
+    def describe(self, label: str) -> str:
+        """Readable name of the global coordinate ``label`` (one of :attr:`labels`): a
+        mechanism coordinate as ``"follower deformation [cam1.q]"`` (its mechanism's
+        ``labels``, :func:`femmech.mechanisms.catalogue.describe`); others unchanged."""
+        for mount in self.mounts:
+            prefix = f"{mount.name}."
+            if label.startswith(prefix) and label[len(prefix):]:
+                return describe(mount.model, label[len(prefix):], prefix)
+        return label
 
     @property
     def is_sparse(self) -> bool:

@@ -24,7 +24,7 @@ from femmech.analysis.nonlinear import integrate_second_kind
 from femmech.analysis.response import SpeedRamp
 from femmech.cli import main
 from femmech.errors import SceneError
-from femmech.scene import Scene, prepare
+from femmech.scene import Scene, prepare, tasks
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 EPS = np.finfo(float).eps
@@ -253,8 +253,16 @@ def test_second_kind_mechanisms_are_refused_where_rheolinear_is_needed():
 
 # --- the scene: end to end -----------------------------------------------------------------
 
-def test_crane_scene_runs_end_to_end(tmp_path):
+def test_crane_scene_runs_end_to_end(tmp_path, monkeypatch):
     out = tmp_path / "out"
+    panels = []
+    plot = tasks.plot_event_histories
+
+    def record(histories, *args, **kwargs):
+        panels.extend(histories)
+        return plot(histories, *args, **kwargs)
+
+    monkeypatch.setattr(tasks, "plot_event_histories", record)
     assert main(["run", str(TOML), "--out", str(out), "--no-cache", "-q"]) == 0
     files = {"drive_event.png", "report.html", "results.json", "run.log",
              "drive_event_braking_0p2s.csv", "drive_event_braking_0p5s.csv",
@@ -281,6 +289,13 @@ def test_crane_scene_runs_end_to_end(tmp_path):
     assert "peak cylinder force" in report
     assert "front axle force" in report
     assert "390.6 kN" in report  # the 0.2 s peak in the table
+    # readable names with the raw ones in brackets (mechanisms.catalogue); CSV: raw names
+    assert "extreme chassis heave [q1] after the trip" in report
+    assert "extreme front axle force [spring1] after the trip" in report
+    assert [p.split("\n")[0] for p in panels] == [
+        "cylinder force [force]", "cylinder length [q4]", "chassis heave [q1]",
+        "chassis pitch [q2]", "pendulum angle [q3]", "front axle force [spring1]",
+        "rear axle force [spring2]"]
 
 
 def _shaft_scene(**event):

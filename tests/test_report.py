@@ -305,8 +305,10 @@ def test_mechanism_only_report_has_no_parts_tables(tmp_path):
     for table in ("Parts", "Materials", "Mass", "Supports", "Reductions"):
         assert not [c for c in captions if c.startswith(table)], table
     (mechanism,) = _table(html, "Mechanisms (parameters")
+    # readable coordinate names with the raw name in brackets (mechanisms.catalogue)
     assert mechanism[:3] == ["machine", "processing_machine (kinematic_drive = true)",
-                             "q2, q3, q4, q5"]
+                             "shaft twist 1 (J0–J1) [q2], shaft twist 2 (J1–J2) [q3],"
+                             " follower 1 deformation [q4], follower 2 deformation [q5]"]
     assert "c3 = 1 MN/m" in mechanism[3]
     assert re.findall(r"<h2>(.*?)</h2>", html)[-1].startswith("Appendix")
     _assert_no_float_artefacts(html)

@@ -491,6 +491,7 @@ def follower_unit(cam, inertia: float, mass: float, stiffness: float, damping: f
     RheolinearModel
     """
     from femmech.mechanisms import Spring, rheolinear, table_5_1_case
+    from femmech.mechanisms.catalogue import coordinate_labels
 
     for name, value in (("inertia", inertia), ("mass", mass), ("stiffness", stiffness),
                         ("damping", damping), ("c_g", c_g)):
@@ -503,7 +504,8 @@ def follower_unit(cam, inertia: float, mass: float, stiffness: float, damping: f
                          f" {stiffness!r}")
     values = {"J1": inertia, "m2": mass, "c1": 0.0, "c2": stiffness, "b1": 0.0,
               "b2": damping, "F2": force}
-    mech = table_5_1_case(1)
+    mech = replace(table_5_1_case(1), labels=coordinate_labels(
+        "follower_unit(cam, inertia, mass, stiffness)"))
     if c_g > 0:
         x2 = next(e.position[0] for e in mech.elements if type(e).__name__ == "PointMass")
         cg = sympy.Symbol("cg", positive=True)

@@ -15,6 +15,8 @@ C stiffness, F force.
 * :mod:`.statics`: static equilibrium (operating point) under gravity and preload.
 * :mod:`.mounted`: mechanisms whose bearings and guides move with an elastic frame.
 * :mod:`.chapter`: built-in models of the seed chapter (Table 5.1, 5.2.3.1, 5.2.3.2).
+* :mod:`.catalogue`: what the built-in models' coordinates and parameters mean (units,
+  signs; the readable labels of tables and plots, docs/mechanisms.md).
 
 Stage 2 (mechanisms, independent of fe): imports only its own modules.
 """

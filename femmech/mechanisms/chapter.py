@@ -17,12 +17,17 @@ drive. Examples
 >>> model.M([0.0, 1.0]).shape
 (2, 2, 2)
 
-Stage 2 (mechanisms, independent of fe): uses mechanisms.symbolic and .motion_laws.
+Coordinate meanings, units and signs: :data:`femmech.mechanisms.catalogue.CATALOGUE`
+(docs/mechanisms.md, "Reference of the built-in mechanisms").
+
+Stage 2 (mechanisms, independent of fe): uses mechanisms.symbolic, .motion_laws and
+.catalogue.
 """
 
 import numpy as np
 import sympy
 
+from femmech.mechanisms.catalogue import coordinate_labels
 from femmech.mechanisms.motion_laws import (
     CamProfile,
     CamSegment,
@@ -101,7 +106,8 @@ def table_5_1_case(case: int) -> Mechanism:
         return _table_5_1_case_4()
     else:
         raise ValueError(f"Table 5.1 has cases 1 to 4, got {case!r}")
-    return Mechanism(coords + (theta,), elements, drives=(theta,), name=f"Table 5.1 case {case}")
+    return Mechanism(coords + (theta,), elements, drives=(theta,), name=f"Table 5.1 case {case}",
+                     labels=coordinate_labels(f"table_5_1_case({case})"))
 
 
 def _table_5_1_case_4() -> Mechanism:
@@ -116,7 +122,8 @@ def _table_5_1_case_4() -> Mechanism:
                 RotaryInertia(J23, o3), Spring(c11, q1), Spring(c12, q2), Spring(c21, o2 - o1),
                 Spring(c22, o3 - o2), Damper(b11, q1), Damper(b12, q2), Damper(b21, o2 - o1),
                 Damper(b22, o3 - o2), Load(-T2, o2), Load(-T3, o3))
-    return Mechanism((q1, q2, theta), elements, drives=(theta,), name="Table 5.1 case 4")
+    return Mechanism((q1, q2, theta), elements, drives=(theta,), name="Table 5.1 case 4",
+                     labels=coordinate_labels("table_5_1_case(4)"))
 
 
 def _processing_machine_parts(q, y1, y2):
@@ -159,9 +166,11 @@ def processing_machine(kinematic_drive: bool = False) -> Mechanism:
     y1, y2 = U1(q[0] + q[1]) + q[3], U2(q[0] + q[1] + q[2]) + q[4]
     elements = _processing_machine_parts(q, y1, y2)
     if kinematic_drive:
-        return Mechanism(q, elements, drives=(q[0],), name="processing machine, kinematic drive")
+        return Mechanism(q, elements, drives=(q[0],), name="processing machine, kinematic drive",
+                         labels=coordinate_labels("processing_machine(kinematic_drive=True)"))
     M0 = sympy.Symbol("M0", real=True)
-    return Mechanism(q, elements + (Load(M0, q[0]),), name="processing machine")
+    return Mechanism(q, elements + (Load(M0, q[0]),), name="processing machine",
+                     labels=coordinate_labels("processing_machine()"))
 
 
 def processing_machine_mixed() -> Mechanism:
@@ -179,7 +188,8 @@ def processing_machine_mixed() -> Mechanism:
     M0 = sympy.Symbol("M0", real=True)
     elements = _processing_machine_parts(q[:5], y1, y2) + (Load(M0, q[0]),)
     constraints = (U1(q[0] + q[1]) - q[5], U2(q[0] + q[1] + q[2]) - q[6])
-    return Mechanism(q, elements, constraints=constraints, name="processing machine, mixed form")
+    return Mechanism(q, elements, constraints=constraints, name="processing machine, mixed form",
+                     labels=coordinate_labels("processing_machine_mixed()"))
 
 
 def processing_machine_parameters(kinematic_drive: bool = True) -> dict[str, float]:
@@ -246,7 +256,8 @@ def mobile_crane() -> Mechanism:
                 RotaryInertia(JS3, beta), PointMass(m5, r5), RotaryInertia(JS5, q3),
                 Spring(c, q1 - l1 * q2), Spring(c, q1 + l2 * q2),
                 Potential(g * (m2 * q1 + m3 * r3[1] + m5 * r5[1])))
-    return Mechanism((q1, q2, q3, q4), elements, drives=(q4,), name="mobile crane")
+    return Mechanism((q1, q2, q3, q4), elements, drives=(q4,), name="mobile crane",
+                     labels=coordinate_labels("mobile_crane()"))
 
 
 def mobile_crane_parameters() -> dict[str, float]:

@@ -18,13 +18,17 @@ Coordinates are small displacements (m) or rotations (rad) about the rigid motio
   along/across the slider axis, ``v_g`` guide displacement across the slider axis,
   ``q`` connecting-rod (output) deformation.
 
-Stage 2 (mechanisms, independent of fe): uses only mechanisms.symbolic.
+Coordinate meanings, units and signs: :data:`femmech.mechanisms.catalogue.CATALOGUE`
+(docs/mechanisms.md, "Reference of the built-in mechanisms").
+
+Stage 2 (mechanisms, independent of fe): uses mechanisms.symbolic and .catalogue.
 """
 
 from __future__ import annotations
 
 import sympy
 
+from femmech.mechanisms.catalogue import coordinate_labels
 from femmech.mechanisms.symbolic import (
     Damper,
     Load,
@@ -82,7 +86,8 @@ def cam_follower(U: str = "U", m: str = "m", c: str = "c", c_return: str = "c_r"
                 Load(-F_, y)]
     if J is not None:
         elements.insert(0, RotaryInertia(sympy.Symbol(J, real=True), psi))
-    return Mechanism((qs, yc, yf, q, theta), tuple(elements), drives=(theta,), name=name)
+    return Mechanism((qs, yc, yf, q, theta), tuple(elements), drives=(theta,), name=name,
+                     labels=coordinate_labels("cam_follower()"))
 
 
 def slider_crank(m: str = "m2", c: str = "c2", J: str = "J1", c_t: str = "c1",
@@ -132,4 +137,5 @@ def slider_crank(m: str = "m2", c: str = "c2", J: str = "J1", c_t: str = "c1",
     x = s + q
     elements = (RotaryInertia(J_, psi), PointMass(m_, (x, vg)), Spring(ct, qt), Spring(c_, q),
                 Damper(bt, qt), Damper(b_, q), Load(-F_, x))
-    return Mechanism((qt, ub, vb, vg, q, theta), elements, drives=(theta,), name=name)
+    return Mechanism((qt, ub, vb, vg, q, theta), elements, drives=(theta,), name=name,
+                     labels=coordinate_labels("slider_crank()"))

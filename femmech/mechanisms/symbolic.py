@@ -20,7 +20,7 @@ Stage 2 (mechanisms, independent of fe): imports nothing of femmech.
 """
 
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import sympy
 
@@ -198,6 +198,12 @@ class Mechanism:
         (seed 5.2.1 eq. 15), used by the mixed-type form.
     name : str
         Label for messages and plots.
+    labels : tuple of (str, str)
+        (coordinate name, what it is physically) pairs, e.g. ``(("q", "follower
+        deformation"),)``, for readable table headers and plot legends
+        (:func:`femmech.mechanisms.catalogue.describe`); the built-in factories give them
+        from :data:`~femmech.mechanisms.catalogue.CATALOGUE`. Not part of equality (two
+        mechanisms that differ only in labels share their cached equations).
 
     Raises
     ------
@@ -210,9 +216,10 @@ class Mechanism:
     drives: tuple[sympy.Symbol, ...] = ()
     constraints: tuple[sympy.Expr, ...] = ()
     name: str = ""
+    labels: tuple[tuple[str, str], ...] = field(default=(), compare=False)
 
     def __post_init__(self):
-        for attr in ("coordinates", "elements", "drives"):
+        for attr in ("coordinates", "elements", "drives", "labels"):
             object.__setattr__(self, attr, tuple(getattr(self, attr)))
         object.__setattr__(self, "constraints", tuple(_expr(f) for f in self.constraints))
         if len(set(self.coordinates)) != len(self.coordinates):
@@ -223,6 +230,13 @@ class Mechanism:
         for d in self.drives:
             if d not in self.coordinates:
                 raise ValueError(f"drive {d} is not one of the coordinates {self.coordinates}")
+        names = {q.name for q in self.coordinates}
+        for item in self.labels:
+            if not (isinstance(item, tuple) and len(item) == 2 and item[0] in names
+                    and isinstance(item[1], str)):
+                raise ValueError(f"mechanism {self.name!r}: labels must be (coordinate name,"
+                                 f" text) pairs of its coordinates {sorted(names)}, got"
+                                 f" {item!r}")
         for i, el in enumerate(self.elements):
             if not isinstance(el, PointMass | RotaryInertia | Spring | Damper | Load | Potential):
                 raise TypeError(f"element {i} has unsupported type {type(el).__name__}")

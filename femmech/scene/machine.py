@@ -28,6 +28,7 @@ from femmech.mechanisms import (
     slider_crank,
     table_5_1_case,
 )
+from femmech.mechanisms.catalogue import CATALOGUE, Entry
 from femmech.mechanisms.motion_laws import LAWS
 from femmech.scene.reader import Reader, file_path, show
 from femmech.scene.units import (
@@ -51,7 +52,8 @@ BUILTIN_MODELS = {"cam_follower": cam_follower, "slider_crank": slider_crank,
                   "mobile_crane": mobile_crane}
 """Built-in mechanism models by scene name → factory of :mod:`femmech.mechanisms`;
 ``options`` are the factory's keyword arguments (checked against its signature). To offer
-a new mechanism type in scenes, add its factory here (and its roles to ``_ROLE_KINDS``)."""
+a new mechanism type in scenes, add its factory here (and its roles to ``_ROLE_KINDS``; its
+coordinates and parameters to :data:`femmech.mechanisms.catalogue.CATALOGUE`)."""
 
 _ROLE_KINDS = {
     "cam_follower": {"m": ("m", MASS), "c": ("c", STIFFNESS), "c_return": ("c_r", STIFFNESS),
@@ -86,21 +88,30 @@ the programmed drive motion, :func:`femmech.mechanisms.rheolinear`; for mounts a
 sweeps; the default) or ``second_kind`` (the nonlinear Lagrange equations of the 2nd kind
 with prescribed drives, :func:`femmech.mechanisms.second_kind`; for drive events)."""
 
-QUANTITIES = {
-    "mobile_crane": {"q1": ("chassis heave", LENGTH), "q2": ("chassis pitch", ANGLE),
-                     "q3": ("pendulum angle", ANGLE), "q4": ("cylinder length", LENGTH),
-                     "force q4": ("cylinder force", FORCE),
-                     "spring1": ("front axle force", FORCE),
-                     "spring2": ("rear axle force", FORCE)},
-    "processing_machine": {"q1": ("drive shaft angle", ANGLE), "q2": ("shaft twist 1", ANGLE),
-                           "q3": ("shaft twist 2", ANGLE),
-                           "q4": ("follower 1 deformation", LENGTH),
-                           "q5": ("follower 2 deformation", LENGTH),
-                           "force q1": ("drive torque", MOMENT)},
-}
-"""Per built-in model: quantity → (what it is physically, its dimension). Quantities are
-coordinate names, ``"force <drive>"`` (the force a drive supplies) and ``"spring<k>"``
-(the force of the k-th spring, 1-based in the mechanism's element order)."""
+_UNIT_KINDS = {"m": LENGTH, "rad": ANGLE, "N": FORCE, "N·m": MOMENT}
+
+
+def catalogue_entry(model: str | None, options: dict) -> Entry | None:
+    """The :data:`~femmech.mechanisms.catalogue.CATALOGUE` entry of a built-in ``model``
+    with its factory ``options`` (None for user modules)."""
+    if model == "table_5_1_case":
+        call = f"table_5_1_case({options.get('case')})"
+    elif model == "processing_machine" and options.get("kinematic_drive"):
+        call = "processing_machine(kinematic_drive=True)"
+    else:
+        call = f"{model}()"
+    return CATALOGUE.get(call)
+
+
+QUANTITIES = {model: {c.name: (c.meaning, _UNIT_KINDS.get(c.unit))
+                      for c in entry.coordinates + entry.quantities}
+              for model, entry in ((m, catalogue_entry(m, {"case": 1, "kinematic_drive": True}))
+                                   for m in BUILTIN_MODELS)}
+"""Per built-in model (its default options; ``table_5_1_case``: case 1): quantity → (what
+it is physically, its dimension), from :data:`femmech.mechanisms.catalogue.CATALOGUE`.
+Quantities are coordinate names, ``"force <drive>"`` (the force a drive supplies) and
+``"spring<k>"`` (the force of the k-th spring, 1-based in the mechanism's element order).
+:func:`describe_quantity` follows the options of a mechanism."""
 
 POSITION_KINDS = ("cam", "slider_crank", "four_bar", "chapter_cam")
 MOTION_LAWS = tuple(LAWS)
@@ -135,8 +146,11 @@ class MechanismSpec:
 def describe_quantity(spec: MechanismSpec, name: str) -> tuple[str, Kind | None]:
     """(physical description, dimension or None) of a quantity of a mechanism (see
     :data:`QUANTITIES`); without a description the name itself, and None when the
-    dimension is unknown (a user module's coordinates)."""
-    return QUANTITIES.get(spec.model, {}).get(name, (name, None))
+    dimension is unknown (a user module's coordinates). For a readable label with the
+    raw name in brackets: :func:`femmech.mechanisms.catalogue.readable`."""
+    entry = catalogue_entry(spec.model, spec.options)
+    found = entry.coordinate(name) if entry is not None else None
+    return (found.meaning, _UNIT_KINDS.get(found.unit)) if found else (name, None)
 
 
 @dataclass(frozen=True)

@@ -29,6 +29,7 @@ from femmech.mechanisms import (
     rheolinear,
     second_kind,
 )
+from femmech.mechanisms.catalogue import describe
 from femmech.mechanisms.motion_laws import LAWS
 from femmech.scene.load import fail
 from femmech.scene.machine import BUILTIN_MODELS
@@ -101,6 +102,16 @@ def coordinate_names(model) -> tuple[str, ...]:
         return tuple(q.name + (" (drive)" if q in drives else "")
                      for q in model.mechanism.coordinates)
     return tuple(model.coordinate_names)
+
+
+def coordinate_labels(model) -> tuple[str, ...]:
+    """Readable names of :func:`coordinate_names` for HTML tables: ``"follower deformation
+    [q]"`` (:func:`femmech.mechanisms.catalogue.describe`), drives marked ``(drive)``."""
+    if isinstance(model, LagrangeModel):
+        drives = set(model.mechanism.drives)
+        return tuple(describe(model, q.name) + (" (drive)" if q in drives else "")
+                     for q in model.mechanism.coordinates)
+    return tuple(describe(model, name) for name in model.coordinate_names)
 
 
 def position_function(scene, p):

@@ -48,7 +48,7 @@ from femmech.scene.cache_folder import default_cache_dir
 from femmech.scene.chain import chain_table
 from femmech.scene.load import SECTION_SHAPES
 from femmech.scene.machine import parameter_kinds
-from femmech.scene.mechanisms import coordinate_names
+from femmech.scene.mechanisms import coordinate_labels
 from femmech.solve import direct, threads
 from femmech.version import __version__
 
@@ -369,7 +369,7 @@ def _mechanisms_table(ws) -> Table:
     rows = []
     for name, spec in ws.scene.mechanisms.items():
         model = ws.prepared.mechanisms.get(name)
-        coords = ", ".join(coordinate_names(model)) if model is not None else "(not built)"
+        coords = ", ".join(coordinate_labels(model)) if model is not None else "(not built)"
         what = spec.model if spec.model else f"{spec.module}:{spec.function}"
         if spec.options:
             what += " (" + ", ".join(f"{k} = {str(v).lower() if isinstance(v, bool) else v}"
@@ -383,7 +383,7 @@ def _mechanisms_table(ws) -> Table:
 
 def _mounts_table(ws) -> Table:
     rows = tuple((m.name, m.mechanism, m.part,
-                  ", ".join(ws.prepared.mechanisms[m.mechanism].coordinate_names)
+                  ", ".join(coordinate_labels(ws.prepared.mechanisms[m.mechanism]))
                   if m.mechanism in ws.prepared.mechanisms else "(not built)",
                   ", ".join(f"{a.coordinate}→{a.node}:{a.direction}"
                             if isinstance(a.direction, str) else f"{a.coordinate}→{a.node}"

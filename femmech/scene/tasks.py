@@ -46,6 +46,7 @@ from femmech.coupling import couple
 from femmech.errors import ConvergenceWarning
 from femmech.fe.model import node_index
 from femmech.mechanisms import Spring, quasi_modes
+from femmech.mechanisms.catalogue import readable
 from femmech.output import export_modes_vtu, frequency_table, plot_mac, write_frequency_csv
 from femmech.output.animate import animate_mode
 from femmech.output.campbell import plot_campbell, plot_margins, plot_synthesis
@@ -344,13 +345,14 @@ def run_response(ws, spec, out):
              if spec.kind == "periodic" else
              f"Run-up {format_speed(spec.speed_start, spec.speed_unit)} →"
              f" {format_speed(spec.speed_end, spec.speed_unit)} in {spec.duration:g} s")
-    _plot_response(r, columns, spec.kind, out / "response.png", title)
+    shown = {k: system.describe(k) for k in columns}  # HTML and plot; the CSV keeps k
+    _plot_response(r, columns, spec.kind, out / "response.png", title, shown)
     loose = r.converged is False
 
     def cell(x):
         return Flagged(f"{x:.6g} NOT CONVERGED") if loose else float(x)
 
-    rows = tuple((k, cell(np.abs(c).max()), cell(c.max() - c.min()))
+    rows = tuple((shown[k], cell(np.abs(c).max()), cell(c.max() - c.min()))
                  for k, c in columns.items())
     if spec.kind == "periodic":
         text = (f"Periodic steady state at {format_speed(spec.speed, spec.speed_unit)} by"
@@ -388,7 +390,8 @@ def _response_unit(name: str) -> str:
     return {"u": "m", "r": "rad"}.get(dof[:1], "m or rad")
 
 
-def _plot_response(r, columns, kind, path, title: str = "") -> None:
+def _plot_response(r, columns, kind, path, title: str = "", shown=None) -> None:
+    """One panel per column; y labels from ``shown`` (column → readable name)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure as MplFigure
 
@@ -401,7 +404,7 @@ def _plot_response(r, columns, kind, path, title: str = "") -> None:
     for i, (name, values) in enumerate(columns.items() or {"(none)": 0 * x}.items()):
         ax = fig.add_subplot(max(1, len(columns)), 1, i + 1)
         ax.plot(x, values, lw=1.0)
-        ax.set_ylabel(f"{name}\n({_response_unit(name)})", fontsize=8)
+        ax.set_ylabel(f"{(shown or {}).get(name, name)}\n({_response_unit(name)})", fontsize=8)
         ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3), useMathText=True)
         ax.grid(alpha=0.3)
         if kind == "periodic":
@@ -627,7 +630,7 @@ def _plot_drive_event(result, runs, values, what, path, title) -> None:
         unit, f = _display(kind, np.concatenate([v[key] for v in values.values()]))
         sign = ", tension +" if key.startswith("spring") and key not in result.coordinate_names \
             else ""
-        ylabel = f"{label}\n({unit}{sign})"
+        ylabel = f"{readable(label, key)}\n({unit}{sign})"
         panels[ylabel] = {run: (h.t, f * values[run][key]) for run, (_, h) in runs.items()}
         if key == "force":
             levels[ylabel] = (f * result.limit, "trip force " + format_value(
@@ -675,7 +678,7 @@ def _drive_event_table(result, values, what, spec) -> Table:
     force_unit = _SI_UNITS[what["force"][1]]
     header = ("braking time", "trip time", "stop time", f"peak {what['force'][0]}",
               "quasi-static at rest", "dynamic factor",
-              *(f"extreme {what[k][0]} after the trip" for k in outputs))
+              *(f"extreme {readable(what[k][0], k)} after the trip" for k in outputs))
     rows = []
     for run, v in zip(result.runs, values.values(), strict=False):
         after = run.history.t >= result.t_trip
