@@ -228,7 +228,7 @@ def _draw_speed_lines(fig, ax, chart, speeds, radius, loose, unstable, quantity:
         ylabel, limit_label = "growth rate ln(max|μ|)/T (1/s)", "stability limit (growth rate 0)"
     name = chart.parameter_name.split(" (")[0] if chart.parameter_name else "value"
     colours = colormaps["viridis"](np.linspace(0.0, 0.85, values.size))
-    handles = {}
+    handles, marked = {}, {}  # the levels first in the legend, then the marks
     for colour, i in zip(colours, order, strict=True):
         (curve,) = ax.plot(speeds, np.where(loose[i], np.nan, y[i]), color=colour, lw=1.4,
                            marker="o", ms=2.5)
@@ -236,17 +236,17 @@ def _draw_speed_lines(fig, ax, chart, speeds, radius, loose, unstable, quantity:
         for a, b in runs(unstable[i]):
             (bad,) = ax.plot(speeds[a:b + 1], y[i, a:b + 1], color=UNSTABLE_COLOR, lw=4.0,
                              alpha=0.7, solid_capstyle="butt")
-            handles[UNSTABLE_LABEL] = bad
+            marked[UNSTABLE_LABEL] = bad
         if loose[i].any():
             (dots,) = ax.plot(speeds[loose[i]], y[i, loose[i]], ls="none", marker="o", ms=6,
                               mfc="none", mec=colour, mew=1.2)
-            handles[LOOSE_LABEL] = dots
-    handles[limit_label] = ax.axhline(limit, color=UNSTABLE_COLOR, lw=0.8, ls="--")
+            marked[LOOSE_LABEL] = dots
+    marked[limit_label] = ax.axhline(limit, color=UNSTABLE_COLOR, lw=0.8, ls="--")
     ax.set_ylabel(ylabel)
     ax.grid(True, lw=0.3, alpha=0.5)
     span = speeds[-1] - speeds[0]
     ax.set_xlim(speeds[0] - 0.01 * span, speeds[-1] + 0.01 * span)
-    return handles
+    return handles | marked
 
 
 def _draw_speed_marks(fig, ax, marks: dict | None, scale: float) -> None:
