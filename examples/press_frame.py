@@ -36,7 +36,9 @@ kinematics, Dresig & Holzweißig, *Maschinendynamik*, ch. 2; C-frame press layou
 Schuler GmbH, *Metal Forming Handbook*, Springer (1998), on press types. Parameters
 are illustrative (SI).
 
-Run: ``python examples/press_frame.py --out out/press``
+Run: ``python examples/press_frame.py --out out/press_example`` (not the scene's ``out/press``:
+both write ``stability_chart.png``, the scene its spectral radius over speed, this script
+its growth rate per frame damping ratio)
 """
 
 from __future__ import annotations
@@ -178,7 +180,7 @@ def rigid_check(phi, n_modes: int = 8):
     return float(np.abs(coupled.freq_hz / expected - 1).max()), coupled, alone
 
 
-def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int | None = None,
+def dynamics(out_dir="out/press_example", spm: float = OPERATING_SPM, n_speeds: int | None = None,
              zetas=(0.0025, 0.005, 0.01, 0.02), n_steps: int = 32) -> dict:
     """Periodic steady state at ``spm`` strokes/min and Floquet stability over speed.
 
@@ -238,7 +240,7 @@ def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int | No
             "study": study, "system": system, "column_foot_My": foot_My}
 
 
-def main(out_dir="out/press", n_angles: int = 181, n_modes: int = 8,
+def main(out_dir="out/press_example", n_angles: int = 181, n_modes: int = 8,
          with_dynamics: bool = True, n_speeds: int | None = None) -> dict:
     """Sweep over one revolution (BDC at 0° and 360°, TDC at 180°), plot, CSV, checks."""
     out = Path(out_dir)
@@ -273,7 +275,7 @@ def main(out_dir="out/press", n_angles: int = 181, n_modes: int = 8,
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out/press")
+    parser.add_argument("--out", default="out/press_example")
     parser.add_argument("--angles", type=int, default=181)
     parser.add_argument("--speeds", type=int, default=None, help="speeds of the stability"
                         " chart (default: those of the scene, press_frame.toml)")
