@@ -63,6 +63,7 @@ from femmech.chain.sweep import compare_methods
 from femmech.chain.synthesis import Parameter, frequency_bands, resonance_margin, synthesise
 from femmech.mechanisms import cam_program
 from femmech.output.campbell import plot_campbell, plot_synthesis
+from femmech.output.formatting import format_value
 from femmech.output.sweeps import plot_quasi_frequencies
 
 N_UNITS = 28
@@ -81,6 +82,9 @@ INITIAL = {"coupling_stiffness": 1e4,  # N m/rad
 BOUNDS = {"coupling_stiffness": (2e3, 5e4), "shaft_diameter": (0.04, 0.06),
           "follower_mass": (0.3, 1.0), "follower_stiffness": (1e5, 5e5)}
 LOG_SCALE = ("coupling_stiffness", "follower_stiffness")
+UNITS = {"coupling_stiffness": "N·m/rad", "shaft_diameter": "m", "follower_mass": "kg",
+         "follower_stiffness": "N/m"}
+"""Unit of each design value (SI), for the printed summary."""
 
 
 def cam():
@@ -143,10 +147,29 @@ def main(out_dir="out", n_angles: int = 73, starts: int = 2) -> dict:
             "seconds": seconds, "plots": plots, "result": result}
 
 
+def summary_lines(numbers: dict) -> list[str]:
+    """The printed summary of :func:`main`'s result: 4 significant digits with units
+    (relative differences and margins in %, design values in SI, times in s)."""
+    def relative(x):
+        return format_value(100 * x, "%")
+
+    designs = {key: ", ".join(f"{name} {format_value(v, UNITS[name])}"
+                              for name, v in numbers[key].items()) for key in ("before", "after")}
+    return [
+        "max relative difference from the assembled frequencies: " + ", ".join(
+            f"{m} {relative(d)}" for m, d in numbers["max_rel_difference"].items()),
+        f"margin from the harmonic bands (required {relative(MARGIN)}): before"
+        f" {relative(numbers['margin_before'])}, after {relative(numbers['margin_after'])},"
+        f" after on 360 angles {relative(numbers['check_after'])}",
+        f"feasible: {'yes' if numbers['feasible'] else 'no'}",
+        f"before: {designs['before']}",
+        f"after: {designs['after']}",
+        "seconds: " + ", ".join(f"{step} {format_value(t, 's')}"
+                                for step, t in numbers["seconds"].items()),
+    ]
+
+
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="out/", help="output folder for the PNGs")
-    numbers = main(parser.parse_args().out)
-    for key in ("max_rel_difference", "margin_before", "margin_after", "check_after",
-                "feasible", "before", "after", "seconds"):
-        print(f"{key}: {numbers[key]}")
+    print("\n".join(summary_lines(main(parser.parse_args().out))))

@@ -36,7 +36,9 @@ kinematics, Dresig & Holzweißig, *Maschinendynamik*, ch. 2; C-frame press layou
 Schuler GmbH, *Metal Forming Handbook*, Springer (1998), on press types. Parameters
 are illustrative (SI).
 
-Run: ``python examples/press_frame.py --out out/press``
+Run: ``python examples/press_frame.py --out out/press_example`` (not the scene's ``out/press``:
+both write ``stability_chart.png``, the scene its spectral radius over speed, this script
+its growth rate per frame damping ratio)
 """
 
 from __future__ import annotations
@@ -73,6 +75,7 @@ from femmech.output.histories import plot_orbit, plot_time_histories, write_hist
 from femmech.output.stability_charts import plot_speed_study
 from femmech.output.sweeps import plot_quasi_frequencies, write_sweep_csv
 from femmech.reduction import craig_bampton
+from femmech.scene.load import load_scene
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")
 GEOMETRY = {"r": 0.05, "l": 0.35, "e": 0.0}  # m
@@ -95,6 +98,17 @@ ELEMENT_SIZE = 0.1  # m
 DAMPED = {**PARAMS, "b1": 50.0, "b2": 1.5e4}
 FRAME_ZETA, ZETA_BAND_HZ = 0.02, (60.0, 400.0)
 OPERATING_SPM = 600.0  # strokes per minute
+SCENE = Path(__file__).with_suffix(".toml")  # the same press as a scene
+
+
+def study_speeds(n_speeds: int | None = None) -> np.ndarray:
+    """Drive speeds of the stability study, rad/s: the range the scene's
+    ``[analyses.stability] speeds`` asks for (100..3000 strokes/min), at ``n_speeds``
+    evenly spaced points (None: the scene's own speeds)."""
+    speeds = load_scene(SCENE).analyses.stability.speeds
+    if n_speeds is None:
+        return np.asarray(speeds, dtype=float)
+    return np.linspace(min(speeds), max(speeds), n_speeds)
 
 
 def frame_mesh(element_size: float = ELEMENT_SIZE) -> fm.Mesh:
@@ -166,7 +180,7 @@ def rigid_check(phi, n_modes: int = 8):
     return float(np.abs(coupled.freq_hz / expected - 1).max()), coupled, alone
 
 
-def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int = 70,
+def dynamics(out_dir="out/press_example", spm: float = OPERATING_SPM, n_speeds: int | None = None,
              zetas=(0.0025, 0.005, 0.01, 0.02), n_steps: int = 32) -> dict:
     """Periodic steady state at ``spm`` strokes/min and Floquet stability over speed.
 
@@ -176,7 +190,9 @@ def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int = 70
     for j = n+1), the column-foot bending moment (elastic section force) and the orbit of
     the crank bearing. Stability
     (:func:`femmech.analysis.stability.speed_study`): growth rate ln(max|μ|)/T over
-    120..1500 strokes/min at the nominal damping and over the frame damping ratio, with
+    the speeds the scene asks for (:func:`study_speeds`: 100..3000 strokes/min, the scene's
+    30 points unless ``n_speeds`` is given) at the nominal damping and per frame damping
+    ratio (one curve each), with
     the principal parametric resonances 2 f_k / j of the two lowest branches marked.
     """
     out = Path(out_dir)
@@ -212,7 +228,7 @@ def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int = 70
                             **{f"{k}_N": f for k, f in force_curves.items()},
                             "drive_torque_Nm": torque, "column_foot_My_Nm": foot_My},
                       out / "steady_state.csv")
-    study = speed_study(base, 2 * np.pi * np.linspace(2.0, 25.0, n_speeds), FRAME_ZETA,
+    study = speed_study(base, study_speeds(n_speeds), FRAME_ZETA,
                         ZETA_BAND_HZ, zetas, n_steps=n_steps, orders=range(1, 9))
     plot_speed_study(study, out, "Press")
     print(f"steady state at {spm:.0f} strokes/min: ram deflection {1e6 * np.ptp(q_ram):.1f} µm"
@@ -224,8 +240,8 @@ def dynamics(out_dir="out/press", spm: float = OPERATING_SPM, n_speeds: int = 70
             "study": study, "system": system, "column_foot_My": foot_My}
 
 
-def main(out_dir="out/press", n_angles: int = 181, n_modes: int = 8,
-         with_dynamics: bool = True, n_speeds: int = 70) -> dict:
+def main(out_dir="out/press_example", n_angles: int = 181, n_modes: int = 8,
+         with_dynamics: bool = True, n_speeds: int | None = None) -> dict:
     """Sweep over one revolution (BDC at 0° and 360°, TDC at 180°), plot, CSV, checks."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -259,8 +275,9 @@ def main(out_dir="out/press", n_angles: int = 181, n_modes: int = 8,
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out/press")
+    parser.add_argument("--out", default="out/press_example")
     parser.add_argument("--angles", type=int, default=181)
-    parser.add_argument("--speeds", type=int, default=70, help="speeds of the stability chart")
+    parser.add_argument("--speeds", type=int, default=None, help="speeds of the stability"
+                        " chart (default: those of the scene, press_frame.toml)")
     args = parser.parse_args()
     main(args.out, args.angles, n_speeds=args.speeds)

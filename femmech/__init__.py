@@ -7,8 +7,6 @@ Not a stage: it re-exports the public API of the stages (docs/architecture.md);
 nothing inside femmech imports it.
 """
 
-from femmech.analysis.discretisation import DiscretisationEstimate, discretisation_error
-from femmech.analysis.modes import ModeSet, modes
 from femmech.errors import (
     CacheWarning,
     ConvergenceWarning,
@@ -20,24 +18,36 @@ from femmech.errors import (
     SceneError,
     UserCodeError,
 )
-from femmech.fe import generators, sections
-from femmech.fe.constraints import InterpolatingLink, RigidLink, Support
-from femmech.fe.lumped import PointMass, Spring
-from femmech.fe.materials import Material
-from femmech.fe.mesh import Mesh
-from femmech.fe.mesh_io import read_mesh
-from femmech.fe.model import (
-    BeamProperty,
-    FEModel,
-    ShellProperty,
-    ShellSet,
-    SolidProperty,
-    SolidSet,
-    build_model,
-)
-from femmech.fe.refine import refine_mesh
-from femmech.fe.sections import BeamSection
 from femmech.version import __version__
+
+_LAZY = {
+    "DiscretisationEstimate": "femmech.analysis.discretisation",
+    "discretisation_error": "femmech.analysis.discretisation",
+    "ModeSet": "femmech.analysis.modes",
+    "modes": "femmech.analysis.modes",
+    "generators": "femmech.fe",
+    "sections": "femmech.fe",
+    "InterpolatingLink": "femmech.fe.constraints",
+    "RigidLink": "femmech.fe.constraints",
+    "Support": "femmech.fe.constraints",
+    "PointMass": "femmech.fe.lumped",
+    "Spring": "femmech.fe.lumped",
+    "Material": "femmech.fe.materials",
+    "Mesh": "femmech.fe.mesh",
+    "read_mesh": "femmech.fe.mesh_io",
+    "BeamProperty": "femmech.fe.model",
+    "FEModel": "femmech.fe.model",
+    "ShellProperty": "femmech.fe.model",
+    "ShellSet": "femmech.fe.model",
+    "SolidProperty": "femmech.fe.model",
+    "SolidSet": "femmech.fe.model",
+    "build_model": "femmech.fe.model",
+    "refine_mesh": "femmech.fe.refine",
+    "BeamSection": "femmech.fe.sections",
+}
+"""Public name → the module it lives in, imported on first use (PEP 562), so that
+``import femmech`` (and every ``python -m femmech`` command, e.g. ``femmech check``)
+imports neither the solvers nor the analyses it does not use."""
 
 __all__ = [
     "__version__",
@@ -87,10 +97,21 @@ _OLD_MODULES = frozenset({
 
 
 def __getattr__(name: str):
-    """An old top-level module (``fm.linalg``) as an attribute: its names warn and lead to
-    their new places."""
-    if name in _OLD_MODULES:
-        import importlib
+    """A public name from its module, imported on first use (:data:`_LAZY`); an old
+    top-level module (``fm.linalg``) as an attribute: its names warn and lead to their
+    new places."""
+    import importlib
 
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name]), name, None)
+        if value is None:  # a module of the package (femmech.fe.generators)
+            value = importlib.import_module(f"{_LAZY[name]}.{name}")
+        globals()[name] = value  # later look-ups skip this function
+        return value
+    if name in _OLD_MODULES:
         return importlib.import_module(f"femmech.{name}")
     raise AttributeError(f"module 'femmech' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

@@ -162,3 +162,27 @@ def test_verbosity_through_logging(scene, tmp_path, capsys):
     import logging
 
     assert not logging.getLogger("femmech").handlers  # nothing left behind
+
+
+CHECK_IMPORTS = """
+import sys
+from femmech.cli import main
+code = main(["check", sys.argv[1]])
+print(code, *sorted(m for m in sys.modules if m.split(".")[0] in {"pyvista", "vtk",
+      "vtkmodules", "matplotlib"} or m in {"femmech.output.plot", "femmech.output.renderer",
+      "femmech.analysis.modes", "femmech.analysis.stability", "femmech.chain.synthesis",
+      "scipy.optimize", "scipy.interpolate"}))
+"""
+"""Runs ``femmech check`` and prints its exit code and the unwanted modules it imported."""
+
+
+@pytest.mark.parametrize("name", ["press_frame.toml", "frame_modes.toml"])
+def test_check_imports_no_rendering_and_no_solver(name):
+    """``femmech check`` validates a scene without the rendering stack (pyvista, vtk,
+    matplotlib), the modules that draw or solve (mode and stability analyses, the chain
+    optimiser) and scipy's optimiser: a fresh interpreter has none of them afterwards.
+    Structural, not timed (benchmarks/check_time.py times it)."""
+    done = subprocess.run([sys.executable, "-c", CHECK_IMPORTS, str(ROOT / "examples" / name)],
+                          cwd=ROOT, capture_output=True, text=True, timeout=120, check=False)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[-1] == "0", done.stdout

@@ -1,6 +1,7 @@
 """The shipped examples run and reproduce independently computed numbers."""
 
 import importlib.util
+import re
 from pathlib import Path
 
 import numpy as np
@@ -121,6 +122,37 @@ def test_textile_shaft_reduced_matches_full(tmp_path):
     assert (tmp_path / "mac_reduced_vs_full.png").stat().st_size > 5_000
     assert (tmp_path / "coupled_mode_1.png").stat().st_size > 10_000
     assert (tmp_path / "quasi_frequencies.json").stat().st_size > 1_000
+
+
+FLOAT = re.compile(r"\d+\.\d+(?:e[-+]?\d+)?|\d+e[-+]?\d+")
+"""A decimal or exponent float in printed text (integers are not floats)."""
+
+
+def significant_digits(text: str) -> int:
+    """Significant digits of one float as printed: mantissa digits without leading zeros."""
+    return len(text.split("e")[0].replace(".", "").lstrip("0"))
+
+
+def test_knitting_summary_prints_engineering_numbers():
+    # what main() returns, with the binary artefacts of real results (16-17 digits)
+    module = _load("knitting_machine_chain")
+    numbers = {"max_rel_difference": {"assembled": 0.0, "transfer": 2.4123456789012345e-13,
+                                      "continuum": 0.020123456789012345},
+               "margin_before": -0.012345678901234567, "margin_after": 0.030000000000000027,
+               "check_after": 0.029987654321098765, "feasible": True,
+               "before": dict(module.INITIAL),
+               "after": {"coupling_stiffness": 4567.891234567891,
+                         "shaft_diameter": 0.05123456789012345,
+                         "follower_mass": 0.41234567890123456,
+                         "follower_stiffness": 499999.99999999994},
+               "seconds": {"sweeps": 1.2345678901234567, "synthesis": 45.678901234567895}}
+    lines = module.summary_lines(numbers)
+    floats = [f for line in lines for f in FLOAT.findall(line)]
+    assert len(floats) >= 12  # every number above but the exact zero is a float
+    assert max(significant_digits(f) for f in floats) <= 6, lines
+    text = "\n".join(lines)
+    assert "after: coupling_stiffness 4.568 kN·m/rad" in text  # units with the values
+    assert "before -1.235 %" in text  # margins in per cent
 
 
 @pytest.mark.slow

@@ -5,6 +5,7 @@ the steady-state / stability sections of the coupled-machine examples."""
 import dataclasses
 import importlib.util
 import sys
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -253,7 +254,16 @@ def test_press_dynamics(tmp_path):
         assert abs(forces.forces[k, 2]) < 5e-3 * abs(forces.forces[0, 0])
     study = result["study"]
     assert study.chart.spectral_radius.shape == (2, 3)
-    assert study.line.stable.all()  # damped press: stable in 120..1500 strokes/min
+    assert study.line.stable.all()  # damped press: stable in 100..3000 strokes/min
+    # the study covers the speeds the scene asks for ([analyses.stability] speeds of
+    # press_frame.toml, read independently here): first and last speed, also in the chart
+    scene = tomllib.loads((EXAMPLES / "press_frame.toml").read_text())["analyses"]
+    asked = scene["stability"]["speeds"]
+    assert (asked["start"], asked["stop"]) == ("100 rpm", "3000 rpm")
+    rpm = 30 / np.pi  # rad/s -> rpm
+    for drawn in (study.line, study.chart):
+        # bound: rpm -> rad/s -> rpm in float64, a few eps of 3000
+        assert drawn.speeds[[0, -1]] * rpm == pytest.approx([100.0, 3000.0], rel=1e-12)
     for name in ("steady_state.png", "crank_bearing_orbit.png", "steady_state.csv",
                  "stability_speed.png", "stability_chart.png"):
         assert (tmp_path / name).stat().st_size > 1000

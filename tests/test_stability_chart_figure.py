@@ -200,3 +200,30 @@ def test_one_legend_below_the_plot():
     renderer = fig.canvas.get_renderer()
     legend = ax.get_legend().get_window_extent(renderer)
     assert legend.y1 <= ax.xaxis.get_tightbbox(renderer).y0 + 0.5  # below the x label
+
+
+def test_damping_levels_are_named_curves_over_speed():
+    """layout='lines' (what plot_speed_study draws): one curve per damping level, each named
+    in the legend by its value and drawn from the first to the last speed, the unstable run
+    of a level as a red segment on its curve; a plane of four levels drew wide flat bands
+    that no legend named."""
+    zetas = [0.0025, 0.005, 0.01, 0.02]
+    radius = np.full((4, 12), 0.9)
+    radius[0, 5:7] = 1.01  # the lightest damping crosses the limit at two speeds
+    c = chart(radius, values=zetas)
+    fig = stability_figure(c, quantity="growth_rate", speed_unit="rpm", layout="lines")
+    ax = fig.axes[0]
+    assert len(fig.axes) == 1  # no colour bar: the legend names the levels
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert [f"frame damping ratio ζ = {z:g}" for z in zetas] == labels[:4]
+    assert labels[4:] == ["unstable (ρ > 1 + tol)", "stability limit (growth rate 0)"]
+    lo, hi = ax.get_xlim()
+    # bound: the limits are the speeds ± 1 % of the span, computed in float: ~eps of 1e3
+    assert lo <= c.speeds[0] * RPM <= lo + 0.011 * (hi - lo)
+    assert hi - 0.011 * (hi - lo) <= c.speeds[-1] * RPM <= hi
+    red = [line for line in ax.get_lines() if line.get_linewidth() > 2
+           and to_rgb(line.get_color()) == pytest.approx(RED)]
+    assert len(red) == 1
+    assert red[0].get_xdata() == pytest.approx(c.speeds[5:7] * RPM)
+    with pytest.raises(ValueError, match="layout"):
+        stability_figure(c, layout="bands")

@@ -33,15 +33,18 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from femmech.coupling import CoupledSystem, assemble_at, frame_row, require_dense_primal
 from femmech.errors import ConvergenceWarning
 from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
 from femmech.fe.model import node_index
 from femmech.html import Flag, html_summary
 from femmech.mechanisms.motion_laws import motion_law
+
+if TYPE_CHECKING:
+    from femmech.coupling import CoupledSystem
 
 
 @dataclass(frozen=True)
@@ -194,6 +197,8 @@ def _drive(drive, t):
 
 def _matrices(system, phi, Omega, Omega_dot):
     """``matrices_at(k) -> (M, B, C, F)`` (dense) for the k-th time point."""
+    from femmech.coupling import CoupledSystem, assemble_at, require_dense_primal
+
     if isinstance(system, CoupledSystem):
         require_dense_primal(system, "the response")
         blocks = system.mechanism_blocks(phi, Omega, Omega_dot)  # one vectorised call
@@ -516,6 +521,8 @@ def frame_history(system: CoupledSystem, model, q_history, dofs) -> np.ndarray:
     if q_history.ndim != 2 or q_history.shape[1] != system.n:
         raise ValueError(f"q_history must have shape (n_t, {system.n}), got"
                          f" {q_history.shape}")
+    from femmech.coupling import frame_row
+
     rows = np.array([frame_row(system.frame, *_node_component(model, d)) for d in dofs])
     return q_history[:, :system.n_frame] @ rows.T
 

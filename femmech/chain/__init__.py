@@ -16,22 +16,50 @@
 Stage 6 (chain): may import analysis, coupling, reduction, mechanisms, fe, solve.
 """
 
-from femmech.chain.continuum import continuum_error_table, continuum_modes
-from femmech.chain.cyclic import cyclic_modes, is_uniform, pass_bands
-from femmech.chain.frame import guided_unit, mount_chain
-from femmech.chain.model import Chain, End, chain, follower_unit, torsion_segment
-from femmech.chain.results import ChainModes
-from femmech.chain.sweep import chain_sweep, compare_methods
-from femmech.chain.synthesis import (
-    Parameter,
-    SynthesisResult,
-    resonance_margin,
-    synthesise,
-)
-from femmech.chain.transfer import assembled_modes, count_below, transfer_modes
+_LAZY = {
+    "continuum_error_table": "femmech.chain.continuum",
+    "continuum_modes": "femmech.chain.continuum",
+    "cyclic_modes": "femmech.chain.cyclic",
+    "is_uniform": "femmech.chain.cyclic",
+    "pass_bands": "femmech.chain.cyclic",
+    "guided_unit": "femmech.chain.frame",
+    "mount_chain": "femmech.chain.frame",
+    "Chain": "femmech.chain.model",
+    "End": "femmech.chain.model",
+    "chain": "femmech.chain.model",
+    "follower_unit": "femmech.chain.model",
+    "torsion_segment": "femmech.chain.model",
+    "ChainModes": "femmech.chain.results",
+    "chain_sweep": "femmech.chain.sweep",
+    "compare_methods": "femmech.chain.sweep",
+    "Parameter": "femmech.chain.synthesis",
+    "SynthesisResult": "femmech.chain.synthesis",
+    "resonance_margin": "femmech.chain.synthesis",
+    "synthesise": "femmech.chain.synthesis",
+    "assembled_modes": "femmech.chain.transfer",
+    "count_below": "femmech.chain.transfer",
+    "transfer_modes": "femmech.chain.transfer",
+}
+"""Public name → its module, imported on first use: a scene that only describes a chain
+(``femmech check``) needs :mod:`.model`, not the optimiser of :mod:`.synthesis`."""
 
 __all__ = ["guided_unit", "mount_chain", "Chain", "End", "chain", "follower_unit",
            "torsion_segment", "Parameter", "SynthesisResult", "resonance_margin", "synthesise",
            "cyclic_modes", "is_uniform", "pass_bands", "continuum_modes",
            "continuum_error_table", "ChainModes", "transfer_modes", "count_below",
            "assembled_modes", "chain_sweep", "compare_methods"]
+
+
+def __getattr__(name: str):
+    """A public name from its module, imported on first use (:data:`_LAZY`, PEP 562)."""
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value  # later look-ups skip this function
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

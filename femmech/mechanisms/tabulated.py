@@ -16,7 +16,6 @@ Stage 2 (mechanisms, independent of fe): uses only mechanisms.position.
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.interpolate import make_interp_spline
 
 from femmech.mechanisms.position import as_angles, check_order
 
@@ -87,6 +86,8 @@ class TabulatedPositionFunction:
             raise ValueError(f"the table is not periodic: U[-1] - U[0] - increment = {gap:.3g}, "
                              f"more than rtol * range = {self.rtol * scale:.3g}")
         periodic[-1] = periodic[0]
+        from scipy.interpolate import make_interp_spline  # 0.5 s of imports: only when used
+
         spline = make_interp_spline(phi, periodic, k=5, bc_type="periodic")
         object.__setattr__(self, "phi", phi)
         object.__setattr__(self, "U", U)

@@ -1,7 +1,8 @@
 """Output of results: off-screen images (pyvista), VTU files (meshio), frequency tables.
 
-pyvista is imported only inside the plotting functions, so importing this package
-does not import pyvista.
+pyvista and matplotlib are imported only inside the plotting functions, and the names
+below only on first use, so importing this package or any of its submodules imports
+neither.
 
 * :mod:`.plot`: off-screen images of mode shapes with pyvista (PNG), one scene and one
   camera per model.
@@ -26,16 +27,24 @@ Stage 7 (output): uses analysis, coupling, reduction, fe and errors; of femmech 
 :mod:`femmech.scene` imports it.
 """
 
-from femmech.output.export import atomic_path, export_modes_vtu
-from femmech.output.machine import plot_coupled_mode
-from femmech.output.plot import mode_mesh, mode_scale, mode_title, plot_mode, plot_modes
-from femmech.output.sweeps import (
-    plot_mac,
-    plot_quasi_frequencies,
-    write_sweep_csv,
-    write_sweep_json,
-)
-from femmech.output.tables import frequency_table, write_frequency_csv
+_LAZY = {
+    "atomic_path": "femmech.output.export",
+    "export_modes_vtu": "femmech.output.export",
+    "plot_coupled_mode": "femmech.output.machine",
+    "mode_mesh": "femmech.output.plot",
+    "mode_scale": "femmech.output.plot",
+    "mode_title": "femmech.output.plot",
+    "plot_mode": "femmech.output.plot",
+    "plot_modes": "femmech.output.plot",
+    "plot_mac": "femmech.output.sweeps",
+    "plot_quasi_frequencies": "femmech.output.sweeps",
+    "write_sweep_csv": "femmech.output.sweeps",
+    "write_sweep_json": "femmech.output.sweeps",
+    "frequency_table": "femmech.output.tables",
+    "write_frequency_csv": "femmech.output.tables",
+}
+"""Public name → its module, imported on first use: importing a submodule (the scene
+reader uses :mod:`.formatting` and :mod:`.charts`) does not import the plotting modules."""
 
 __all__ = [
     "atomic_path",
@@ -53,3 +62,18 @@ __all__ = [
     "write_sweep_csv",
     "write_sweep_json",
 ]
+
+
+def __getattr__(name: str):
+    """A public name from its module, imported on first use (:data:`_LAZY`, PEP 562)."""
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value  # later look-ups skip this function
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

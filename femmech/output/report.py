@@ -26,7 +26,6 @@ from numbers import Real
 from pathlib import Path
 
 from femmech.html import Markup, element, fragment
-from femmech.output.export import atomic_path
 from femmech.output.formatting import Quantity, format_value, is_flagged
 
 CSS = """
@@ -222,6 +221,8 @@ def write_report(out_dir, title: str, meta: str, sections, log_lines=(),
             if not (out / file).is_file():
                 raise FileNotFoundError(f"report section {section.title!r} references"
                                         f" {file}, which is not in {out}")
+    from femmech.output.export import atomic_path  # meshio: not for a scene's tables
+
     target = out / name
     with atomic_path(target) as tmp:
         tmp.write_text(render_report(title, meta, sections, log_lines), encoding="utf-8")

@@ -107,7 +107,7 @@ def chart_legend(unstable: np.ndarray, loose: np.ndarray, loose_mark: str = "hat
 
 def stability_figure(chart, title: str = "Floquet stability", speed_label: str | None = None,
                      marks: dict | None = None, quantity: str = "radius",
-                     speed_unit: str = "rad/s"):
+                     speed_unit: str = "rad/s", layout: str = "plane"):
     """The matplotlib Figure of :func:`plot_stability_chart` (same arguments)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -115,6 +115,8 @@ def stability_figure(chart, title: str = "Floquet stability", speed_label: str |
     scale = speed_scale(speed_unit)
     if quantity not in ("radius", "growth_rate"):
         raise ValueError(f"quantity must be 'radius' or 'growth_rate', got {quantity!r}")
+    if layout not in ("plane", "lines"):
+        raise ValueError(f"layout must be 'plane' or 'lines', got {layout!r}")
     speeds, radius = scale * np.asarray(chart.speeds), np.asarray(chart.spectral_radius)
     if speeds.size < 2 or radius.shape != (radius.shape[0], speeds.size):
         raise ValueError(f"the chart needs >= 2 speeds and radii (n_values, {speeds.size}),"
@@ -125,10 +127,12 @@ def stability_figure(chart, title: str = "Floquet stability", speed_label: str |
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     line = chart.values is None or len(chart.values) < 2
-    draw = _draw_speed_line if line else _draw_speed_plane
+    draw = _draw_speed_line if line else (_draw_speed_lines if layout == "lines"
+                                          else _draw_speed_plane)
     handles = draw(fig, ax, chart, speeds, radius, loose, unstable, quantity)
     ax.set_xlabel(speed_label or f"drive speed ({speed_unit})")
-    legend = f"({chart_legend(unstable, loose, 'hatched' if line else 'hollow circles')})"
+    mark = "hatched" if line else "hollow circles"
+    legend = f"({chart_legend(unstable, loose, mark)})"
     whole = f"{title} {legend}"
     fig.suptitle(whole if len(whole) <= 90 else f"{textwrap.fill(title, 90)}\n{legend}",
                  fontsize=11)
@@ -207,6 +211,44 @@ def _draw_speed_plane(fig, ax, chart, speeds, radius, loose, unstable, quantity:
     return handles
 
 
+def _draw_speed_lines(fig, ax, chart, speeds, radius, loose, unstable, quantity: str) -> dict:
+    """One curve over speed per value of the second parameter, in the legend by its value
+    (few values, e.g. frame damping levels, whose curves a plane would draw as wide flat
+    bands): the converged points joined, unstable runs as thick red segments on their
+    curve, unconverged points as hollow circles. Returns the legend entries."""
+    from matplotlib import colormaps
+
+    values = np.asarray(chart.values, dtype=float)
+    order = np.argsort(values)
+    if quantity == "radius":
+        y, limit, ylabel = radius, 1.0 + chart.tol, "spectral radius max|μ|"
+        limit_label = "stability limit ρ = 1 + tol"
+    else:
+        y, limit = np.asarray(chart.growth_rate, dtype=float), 0.0
+        ylabel, limit_label = "growth rate ln(max|μ|)/T (1/s)", "stability limit (growth rate 0)"
+    name = chart.parameter_name.split(" (")[0] if chart.parameter_name else "value"
+    colours = colormaps["viridis"](np.linspace(0.0, 0.85, values.size))
+    handles, marked = {}, {}  # the levels first in the legend, then the marks
+    for colour, i in zip(colours, order, strict=True):
+        (curve,) = ax.plot(speeds, np.where(loose[i], np.nan, y[i]), color=colour, lw=1.4,
+                           marker="o", ms=2.5)
+        handles[f"{name} = {values[i]:.4g}"] = curve
+        for a, b in runs(unstable[i]):
+            (bad,) = ax.plot(speeds[a:b + 1], y[i, a:b + 1], color=UNSTABLE_COLOR, lw=4.0,
+                             alpha=0.7, solid_capstyle="butt")
+            marked[UNSTABLE_LABEL] = bad
+        if loose[i].any():
+            (dots,) = ax.plot(speeds[loose[i]], y[i, loose[i]], ls="none", marker="o", ms=6,
+                              mfc="none", mec=colour, mew=1.2)
+            marked[LOOSE_LABEL] = dots
+    marked[limit_label] = ax.axhline(limit, color=UNSTABLE_COLOR, lw=0.8, ls="--")
+    ax.set_ylabel(ylabel)
+    ax.grid(True, lw=0.3, alpha=0.5)
+    span = speeds[-1] - speeds[0]
+    ax.set_xlim(speeds[0] - 0.01 * span, speeds[-1] + 0.01 * span)
+    return handles | marked
+
+
 def _draw_speed_marks(fig, ax, marks: dict | None, scale: float) -> None:
     """A dotted vertical line at each marked speed (rad/s, drawn × scale) inside the
     speed range, labelled above the plot (no two labels overlap)."""
@@ -221,12 +263,15 @@ def _draw_speed_marks(fig, ax, marks: dict | None, scale: float) -> None:
 def plot_stability_chart(chart, filename, title: str = "Floquet stability",
                          speed_label: str | None = None,
                          marks: dict | None = None, quantity: str = "radius",
-                         speed_unit: str = "rad/s") -> Path:
+                         speed_unit: str = "rad/s", layout: str = "plane") -> Path:
     """Draw a :class:`~femmech.analysis.stability.StabilityChart` as a PNG.
 
-    With a second parameter: the (speed, parameter) plane, each run of unstable speeds
-    (spectral radius > 1 + tol, parametric resonances) of each parameter value a red
-    rectangle; with ``quantity="growth_rate"`` the growth rate as colours. Without: over
+    With a second parameter and ``layout="plane"``: the (speed, parameter) plane, each run
+    of unstable speeds (spectral radius > 1 + tol, parametric resonances) of each
+    parameter value a red rectangle; with ``quantity="growth_rate"`` the growth rate as
+    colours. With ``layout="lines"`` (for a few values, e.g. damping levels): one curve
+    over speed per parameter value, each named in the legend by its value, unstable runs
+    as thick red segments on their curve. Without a second parameter: over
     speed, the spectral radius (``quantity="radius"``; log scale only if it spans more
     than a decade) or the growth rate ln(max|μ|)/T in 1/s (``quantity="growth_rate"``,
     where resonances show as bumps at any speed), with unstable speed ranges shaded.
@@ -237,7 +282,7 @@ def plot_stability_chart(chart, filename, title: str = "Floquet stability",
     plot without overlapping. ``speed_unit`` ("rad/s", "rpm" or "Hz") is the unit of the
     speed axis; ``speed_label`` overrides its label.
     """
-    fig = stability_figure(chart, title, speed_label, marks, quantity, speed_unit)
+    fig = stability_figure(chart, title, speed_label, marks, quantity, speed_unit, layout)
     with atomic_path(filename) as tmp:
         fig.savefig(tmp, format="png")
     return Path(filename)
@@ -247,9 +292,12 @@ def plot_speed_study(study, out_dir, name: str, speed_unit: str = "rpm") -> list
     """The two pictures of a :class:`~femmech.analysis.stability.SpeedStudy` (PNG).
 
     ``stability_speed.png``: growth rate over speed at the nominal frame damping;
-    ``stability_chart.png`` (with damping ratios): growth rate over speed and frame
-    damping, unstable regions shaded. Both mark the predicted resonance speeds; ``name``
-    starts the titles; ``speed_unit`` ("rpm", "rad/s" or "Hz") is the speed axis' unit.
+    ``stability_chart.png`` (with damping ratios): growth rate over speed, one curve per
+    frame damping ratio named in the legend (``layout="lines"``: the growth rate of a
+    stable machine is about -ζω of its least damped mode, nearly constant over speed, so a
+    (speed, ζ) plane of a few ratios shows wide flat bands), unstable runs in red. Both
+    cover the study's speeds and mark the predicted resonance speeds; ``name`` starts the
+    titles; ``speed_unit`` ("rpm", "rad/s" or "Hz") is the speed axis' unit.
     """
     out = Path(out_dir)
     files = [plot_stability_chart(study.line, out / "stability_speed.png",
@@ -259,6 +307,6 @@ def plot_speed_study(study, out_dir, name: str, speed_unit: str = "rpm") -> list
     if study.chart is not None:
         files.append(plot_stability_chart(
             study.chart, out / "stability_chart.png", marks=study.marks,
-            title=f"{name}: growth rate over speed and frame damping",
-            quantity="growth_rate", speed_unit=speed_unit))
+            title=f"{name}: growth rate over speed per frame damping ratio",
+            quantity="growth_rate", speed_unit=speed_unit, layout="lines"))
     return files

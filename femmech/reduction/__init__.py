@@ -19,16 +19,24 @@ Imports :mod:`femmech.errors`, :mod:`femmech.fe` and :mod:`femmech.solve`; never
 mechanisms, coupling or analyses.
 """
 
-from femmech.reduction.component_modes import CUTOFF_FACTOR, craig_bampton, guyan
-from femmech.reduction.estimate import (
-    CoupledErrorForms,
-    coupled_error_estimates,
-    coupled_error_forms,
-    frequency_error_estimates,
-)
-from femmech.reduction.interface_modes import interface_error_estimates, reduce_interface
-from femmech.reduction.substructures import Assembly, assemble_parts
-from femmech.reduction.superelement import FORMAT_VERSION, Superelement, interface_dofs
+_LAZY = {
+    "CUTOFF_FACTOR": "femmech.reduction.component_modes",
+    "craig_bampton": "femmech.reduction.component_modes",
+    "guyan": "femmech.reduction.component_modes",
+    "CoupledErrorForms": "femmech.reduction.estimate",
+    "coupled_error_estimates": "femmech.reduction.estimate",
+    "coupled_error_forms": "femmech.reduction.estimate",
+    "frequency_error_estimates": "femmech.reduction.estimate",
+    "interface_error_estimates": "femmech.reduction.interface_modes",
+    "reduce_interface": "femmech.reduction.interface_modes",
+    "Assembly": "femmech.reduction.substructures",
+    "assemble_parts": "femmech.reduction.substructures",
+    "FORMAT_VERSION": "femmech.reduction.superelement",
+    "Superelement": "femmech.reduction.superelement",
+    "interface_dofs": "femmech.reduction.superelement",
+}
+"""Public name → its module, imported on first use: reading a superelement file or the
+format version does not import the eigensolvers of :mod:`.component_modes`."""
 
 __all__ = [
     "CUTOFF_FACTOR",
@@ -49,8 +57,15 @@ __all__ = [
 
 
 def __getattr__(name: str):
-    """Names this module had before the restructures, from their new places
+    """A public name from its module, imported on first use (:data:`_LAZY`, PEP 562);
+    names this module had before the restructures, from their new places
     (docs/architecture.md, "Moved names")."""
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value  # later look-ups skip this function
+        return value
     from femmech.deprecation import moved
 
     return moved(__name__, name, {
@@ -58,3 +73,7 @@ def __getattr__(name: str):
         "SYMMETRIC_BLOCK": "femmech.reduction.products.SYMMETRIC_BLOCK",
         "THIN_PRODUCT_FLOPS": "femmech.reduction.products.THIN_PRODUCT_FLOPS",
     })
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

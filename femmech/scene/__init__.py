@@ -12,16 +12,31 @@ into one output folder (:mod:`.run`).
 Sits on top: may import every lower stage, nothing imports it but :mod:`femmech.cli`.
 """
 
-from femmech.scene.build import Prepared, part_model, prepare
-from femmech.scene.load import Scene, load_scene
-from femmech.scene.run import RunResult, run_scene
+_LAZY = {
+    "Prepared": "femmech.scene.build",
+    "part_model": "femmech.scene.build",
+    "prepare": "femmech.scene.build",
+    "Scene": "femmech.scene.load",
+    "load_scene": "femmech.scene.load",
+    "RunResult": "femmech.scene.run",
+    "run_scene": "femmech.scene.run",
+}
+"""Public name → its module, imported on first use: ``femmech check`` reads and prepares
+a scene without importing the run (:mod:`.run`: tasks, report, plotting)."""
 
 __all__ = ["Prepared", "RunResult", "Scene", "load_scene", "part_model", "prepare", "run_scene"]
 
 
 def __getattr__(name: str):
-    """Names this module had before the restructures, from their new places
+    """A public name from its module, imported on first use (:data:`_LAZY`, PEP 562);
+    names this module had before the restructures, from their new places
     (docs/architecture.md, "Moved names")."""
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value  # later look-ups skip this function
+        return value
     from femmech.deprecation import moved
 
     return moved(__name__, name, {
@@ -37,3 +52,7 @@ def __getattr__(name: str):
         "ShellSpec": "femmech.scene.load.ShellSpec",
         "SolidSpec": "femmech.scene.load.SolidSpec",
     })
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

@@ -28,11 +28,6 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from femmech.analysis.drive_events import travel_time
-from femmech.analysis.magnus import MAX_STEPS as MONODROMY_MAX_STEPS
-from femmech.analysis.magnus import RTOL as MONODROMY_RTOL
-from femmech.analysis.nonlinear import METHODS as INTEGRATORS
-from femmech.analysis.response import STEADY_STATE_MAX_STEPS, STEADY_STATE_RTOL
 from femmech.errors import SceneError
 from femmech.output.charts import format_speed, speed_resolution
 from femmech.scene.machine import describe_quantity
@@ -348,6 +343,9 @@ def _stability(t: Reader, parts, mechanisms, has_mounts) -> StabilitySpec:
         raise t.error("speeds", "expected >= 2 positive drive speeds (list or {start, stop,"
                                 " n}), e.g. {start = '100 rpm', stop = '3000 rpm', n = 30}")
     n_steps = t.integer("n_steps", 32, minimum=4, maximum=MAX_STEPS, limit="MAX_STEPS")
+    from femmech.analysis.magnus import MAX_STEPS as MONODROMY_MAX_STEPS
+    from femmech.analysis.magnus import RTOL as MONODROMY_RTOL
+
     return StabilitySpec(speeds, n_steps,
                          t.number("angle_period", ANGLE, 2 * np.pi, positive=True),
                          _rayleigh(t), t.number("tol", DIMENSIONLESS, 1e-6, positive=True),
@@ -382,6 +380,8 @@ def _response(t: Reader, parts, mechanisms, has_mounts) -> ResponseSpec:
         raise t.error("outputs", f"{len(outputs)} outputs and {len(dofs)} frame_dofs; at most"
                                  f" {MAX_HISTORIES} histories (limit MAX_HISTORIES)")
     n_steps = t.integer("n_steps", 512, minimum=2, maximum=MAX_STEPS, limit="MAX_STEPS")
+    from femmech.analysis.response import STEADY_STATE_MAX_STEPS, STEADY_STATE_RTOL
+
     return ResponseSpec(kind, speed, n_steps, *ramp, outputs, tuple(dofs), _rayleigh(t),
                         t.number("rtol", DIMENSIONLESS, STEADY_STATE_RTOL, positive=True),
                         t.integer("max_steps", max(STEADY_STATE_MAX_STEPS, n_steps),
@@ -470,6 +470,9 @@ def _is_rotational(t: Reader, spec, drive: str) -> bool:
 
 
 def _drive_event(t: Reader, parts, mechanisms, has_mounts) -> DriveEventSpec:
+    from femmech.analysis.drive_events import travel_time
+    from femmech.analysis.nonlinear import METHODS as INTEGRATORS
+
     mechanism = _second_kind_mechanism(t, mechanisms)
     drive = t.string("drive")
     rotational = _is_rotational(t, mechanisms[mechanism], drive)

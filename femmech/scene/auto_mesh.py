@@ -26,8 +26,6 @@ import warnings
 
 import numpy as np
 
-from femmech.analysis.discretisation import discretisation_error
-from femmech.analysis.modes import modes
 from femmech.errors import ModelWarning
 from femmech.fe import sizing
 from femmech.fe.generators import box, grid_frame, members_frame, rectangular_plate
@@ -148,6 +146,8 @@ def auto_mesh(spec, beams: dict, shells: dict, model_of) -> Mesh:
 
 def _sized_for_modes(spec, n_modes: int, beams: dict, shells: dict, model_of):
     """Counts for a band given as ``n_modes``: (params, f_max in Hz or None)."""
+    from femmech.analysis.modes import modes  # only a sized mesh solves (not check)
+
     params = _coarse_params(spec.generator, spec.params)
     f = None
     for _ in range(MAX_ROUNDS):
@@ -166,6 +166,8 @@ def _checked(spec, params: dict, f_max: float, model_of) -> dict:
     """Shell counts whose estimated discretisation error over (0, f_max] meets the target:
     the estimate of the sized mesh scales the counts where it exceeds it (module
     docstring); flagged (untrusted) estimates count as twice the target."""
+    from femmech.analysis.discretisation import discretisation_error  # solves: not in check
+
     target = spec.target_error
     for attempt in range(MAX_CORRECTIONS + 1):
         _fits(spec.generator, params, refined=True)

@@ -22,10 +22,10 @@ import json
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from femmech.coupling import Attachment, Mount
 from femmech.errors import ModelWarning, SceneError, UserCodeError, did_you_mean, name_list
 from femmech.fe import sections as sec
 from femmech.fe.constraints import InterpolatingLink, RigidLink, Support
@@ -46,8 +46,6 @@ from femmech.fe.model import (
     node_indices,
 )
 from femmech.fe.sections import BeamSection
-from femmech.reduction.component_modes import CUTOFF_FACTOR, craig_bampton, guyan
-from femmech.reduction.superelement import FORMAT_VERSION
 from femmech.scene.auto_mesh import auto_mesh, generate
 from femmech.scene.chain import check_chain
 from femmech.scene.load import PartSpec, Scene, fail
@@ -55,6 +53,9 @@ from femmech.scene.mechanisms import check_drive_event, confined_module, mechani
 from femmech.scene.memory import memory_problem, mesh_counts
 from femmech.scene.mesh import generator_counts
 from femmech.version import __version__
+
+if TYPE_CHECKING:
+    from femmech.coupling import Mount
 
 _ITEMS = {"support": Support, "mass": PointMass, "spring": Spring,
           "rigid_link": RigidLink, "interpolating_link": InterpolatingLink}
@@ -397,6 +398,8 @@ def interface(part: PartSpec) -> list:
 def reduce_part(scene: Scene, part: PartSpec, model: FEModel, f_max_hz: float | None = None):
     """Guyan or Craig-Bampton superelement of the part (``f_max_hz`` overrides the
     scene's mode selection, for the speed-versus-error comparison)."""
+    from femmech.reduction.component_modes import craig_bampton, guyan
+
     r = part.reduction
     try:
         if r.method == "guyan":
@@ -422,6 +425,9 @@ def reduction_key_data(scene: Scene, part: PartSpec, f_max_hz: float | None = No
     keeps). Not in it: the part's name, file paths and scene locations, and the sparse
     solver backend and thread counts, which change a reduction by round-off only.
     """
+    from femmech.reduction.component_modes import CUTOFF_FACTOR
+    from femmech.reduction.superelement import FORMAT_VERSION
+
     data = plain(part)
     del data["name"]
     if part.mesh.file is not None:
@@ -462,6 +468,8 @@ def sha256_key(data) -> str:
 def machine_mounts(prepared: Prepared, part_index: dict | None = None) -> list[Mount]:
     """The scene's mounts as API objects; nodes resolved to indices, as
     ``(part_index, node)`` pairs when ``part_index`` ({part name: index}) is given."""
+    from femmech.coupling import Attachment, Mount
+
     scene = prepared.scene
     out = []
     for m in scene.mounts:
