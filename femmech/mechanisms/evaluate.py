@@ -54,9 +54,24 @@ class CompiledExpressions:
     parameters: tuple[sympy.Symbol, ...]
     position_names: tuple[str, ...]
     _calls: tuple[tuple[str, sympy.Expr], ...]
-    _arg_function: object
-    _function: object
+    _replaced: tuple[sympy.Expr, ...]
+    _placeholders: tuple[sympy.Symbol, ...]
     _size: int
+
+    @functools.cached_property
+    def _arg_function(self):
+        """The position functions' arguments as one numpy function (None without any)."""
+        if not self._calls:
+            return None
+        return sympy.lambdify(self.inputs + self.parameters, [a for _, a in self._calls],
+                              modules="numpy")
+
+    @functools.cached_property
+    def _function(self):
+        """The expressions as one numpy function; lambdify runs at the first evaluation,
+        so that checking a model's bindings (``femmech check``) does not pay for it."""
+        return sympy.lambdify(self.inputs + self.parameters + self._placeholders,
+                              list(self._replaced), modules="numpy", cse=True)
 
     def __call__(self, inputs: Sequence[np.ndarray], parameters: Sequence[float],
                  position_functions: Mapping[str, PositionFunction]) -> np.ndarray:
@@ -114,12 +129,8 @@ def compile_expressions(exprs: tuple[sympy.Expr, ...],
                 if getattr(f, "position_name", None)]
     if leftover:
         raise ValueError(f"could not substitute position functions {leftover}")
-    arg_fn = sympy.lambdify(inputs + params, [a for _, a in calls], modules="numpy") \
-        if calls else None
-    fn = sympy.lambdify(inputs + params + tuple(placeholders), replaced, modules="numpy",
-                        cse=True)
     return CompiledExpressions(inputs, params, tuple(sorted({n for n, _ in calls})),
-                               tuple(calls), arg_fn, fn, len(exprs))
+                               tuple(calls), tuple(replaced), tuple(placeholders), len(exprs))
 
 
 def check_bindings(compiled: Sequence[CompiledExpressions], parameters: Mapping,

@@ -122,3 +122,20 @@ def test_second_kind_generalized_masses_of_a_slider_crank_by_eq_6():
     assert_allclose(model.christoffel(ang)[:, 0, 0, 0], 2 * 1.7 * U1 * U2, rtol=10 * EPS,
                     atol=10 * EPS * np.max(np.abs(U1 * U2)))
     assert lagrange_terms(mech).christoffel.shape == (1, 1, 1)
+
+
+def test_binding_check_compiles_nothing_until_the_first_evaluation():
+    """Checking a model's parameters (``femmech check``) derives the equations but does not
+    lambdify them; the first evaluation does, and gives the closed form."""
+    from femmech.mechanisms.evaluate import check_bindings, compile_expressions
+
+    phi, q, k, m = sympy.symbols("phi q k m")
+    compiled = compile_expressions((k * sympy.cos(phi) + m * q,), (phi, q))
+    assert [s.name for s in compiled.parameters] == ["k", "m"]
+    assert "_function" not in compiled.__dict__     # nothing lambdified yet
+    out = compiled([np.array([0.0, np.pi]), np.array([1.0, 2.0])], [3.0, 5.0], {})
+    assert "_function" in compiled.__dict__
+    # k cos(phi) + m q at (0, 1) and (pi, 2): 3 + 5 = 8, -3 + 10 = 7 (round-off only)
+    np.testing.assert_allclose(out[:, 0], [8.0, 7.0], rtol=1e-12)  # bound: 2 flops, eps 2.2e-16
+    with pytest.raises(ValueError, match="unknown parameters"):
+        check_bindings((compiled,), {"k": 1.0, "m": 1.0, "c": 2.0}, {}, set())
