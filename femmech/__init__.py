@@ -7,6 +7,7 @@ Not a stage: it re-exports the public API of the stages (docs/architecture.md);
 nothing inside femmech imports it.
 """
 
+from femmech.deprecation import lazy_names
 from femmech.errors import (
     CacheWarning,
     ConvergenceWarning,
@@ -96,22 +97,14 @@ _OLD_MODULES = frozenset({
 "Moved names"): ``femmech.io`` etc. still work as attributes of femmech."""
 
 
-def __getattr__(name: str):
-    """A public name from its module, imported on first use (:data:`_LAZY`); an old
-    top-level module (``fm.linalg``) as an attribute: its names warn and lead to their
-    new places."""
+def _old_module(name: str):
+    """An old top-level module (``fm.linalg``) as an attribute of femmech: its names warn
+    and lead to their new places."""
     import importlib
 
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name]), name, None)
-        if value is None:  # a module of the package (femmech.fe.generators)
-            value = importlib.import_module(f"{_LAZY[name]}.{name}")
-        globals()[name] = value  # later look-ups skip this function
-        return value
     if name in _OLD_MODULES:
         return importlib.import_module(f"femmech.{name}")
     raise AttributeError(f"module 'femmech' has no attribute {name!r}")
 
 
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names(__name__, _LAZY, fallback=_old_module)

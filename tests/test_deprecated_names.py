@@ -586,7 +586,8 @@ def test_unknown_names_still_fail():
 
 def _shim_tables() -> tuple[set, set]:
     """(old, name, new) and (old, name, reason) of every ``moved(__name__, name, {...},
-    removed={...})`` call in femmech, read from the source."""
+    removed={...})`` call and every package's ``_MOVED = {...}`` table (for
+    ``lazy_names``) in femmech, read from the source."""
     moved, removed = set(), set()
     for path in sorted(PACKAGE.rglob("*.py")):
         parts = list(path.relative_to(PACKAGE.parent).with_suffix("").parts)
@@ -595,11 +596,15 @@ def _shim_tables() -> tuple[set, set]:
         old = ".".join(parts)
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
-                    and node.func.id == "moved"):
+                    and node.func.id == "moved" and isinstance(node.args[2], ast.Dict)):
                 moved |= {(old, k, v) for k, v in ast.literal_eval(node.args[2]).items()}
                 for keyword in node.keywords:
                     removed |= {(old, k, v)
                                 for k, v in ast.literal_eval(keyword.value).items()}
+            if (isinstance(node, ast.Assign) and len(node.targets) == 1
+                    and getattr(node.targets[0], "id", None) == "_MOVED"):
+                # a package's table for femmech.deprecation.lazy_names(..., moved=_MOVED)
+                moved |= {(old, k, v) for k, v in ast.literal_eval(node.value).items()}
     return moved, removed
 
 

@@ -16,6 +16,8 @@
 Stage 6 (chain): may import analysis, coupling, reduction, mechanisms, fe, solve.
 """
 
+from femmech.deprecation import lazy_names
+
 _LAZY = {
     "continuum_error_table": "femmech.chain.continuum",
     "continuum_modes": "femmech.chain.continuum",
@@ -50,16 +52,4 @@ __all__ = ["guided_unit", "mount_chain", "Chain", "End", "chain", "follower_unit
            "assembled_modes", "chain_sweep", "compare_methods"]
 
 
-def __getattr__(name: str):
-    """A public name from its module, imported on first use (:data:`_LAZY`, PEP 562)."""
-    if name in _LAZY:
-        import importlib
-
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value  # later look-ups skip this function
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names(__name__, _LAZY)

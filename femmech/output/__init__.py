@@ -27,6 +27,8 @@ Stage 7 (output): uses analysis, coupling, reduction, fe and errors; of femmech 
 :mod:`femmech.scene` imports it.
 """
 
+from femmech.deprecation import lazy_names
+
 _LAZY = {
     "atomic_path": "femmech.output.export",
     "export_modes_vtu": "femmech.output.export",
@@ -64,16 +66,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str):
-    """A public name from its module, imported on first use (:data:`_LAZY`, PEP 562)."""
-    if name in _LAZY:
-        import importlib
-
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value  # later look-ups skip this function
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names(__name__, _LAZY)

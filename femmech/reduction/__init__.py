@@ -19,6 +19,8 @@ Imports :mod:`femmech.errors`, :mod:`femmech.fe` and :mod:`femmech.solve`; never
 mechanisms, coupling or analyses.
 """
 
+from femmech.deprecation import lazy_names
+
 _LAZY = {
     "CUTOFF_FACTOR": "femmech.reduction.component_modes",
     "craig_bampton": "femmech.reduction.component_modes",
@@ -56,24 +58,12 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str):
-    """A public name from its module, imported on first use (:data:`_LAZY`, PEP 562);
-    names this module had before the restructures, from their new places
-    (docs/architecture.md, "Moved names")."""
-    if name in _LAZY:
-        import importlib
+_MOVED = {
+    "PIVOT_RTOL": "femmech.reduction.component_modes.PIVOT_RTOL",
+    "SYMMETRIC_BLOCK": "femmech.reduction.products.SYMMETRIC_BLOCK",
+    "THIN_PRODUCT_FLOPS": "femmech.reduction.products.THIN_PRODUCT_FLOPS",
+}
+"""Names this package had before the restructures → their new places (docs/architecture.md,
+"Moved names")."""
 
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value  # later look-ups skip this function
-        return value
-    from femmech.deprecation import moved
-
-    return moved(__name__, name, {
-        "PIVOT_RTOL": "femmech.reduction.component_modes.PIVOT_RTOL",
-        "SYMMETRIC_BLOCK": "femmech.reduction.products.SYMMETRIC_BLOCK",
-        "THIN_PRODUCT_FLOPS": "femmech.reduction.products.THIN_PRODUCT_FLOPS",
-    })
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names(__name__, _LAZY, moved_names=_MOVED)

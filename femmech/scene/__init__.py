@@ -12,6 +12,8 @@ into one output folder (:mod:`.run`).
 Sits on top: may import every lower stage, nothing imports it but :mod:`femmech.cli`.
 """
 
+from femmech.deprecation import lazy_names
+
 _LAZY = {
     "Prepared": "femmech.scene.build",
     "part_model": "femmech.scene.build",
@@ -27,32 +29,20 @@ a scene without importing the run (:mod:`.run`: tasks, report, plotting)."""
 __all__ = ["Prepared", "RunResult", "Scene", "load_scene", "part_model", "prepare", "run_scene"]
 
 
-def __getattr__(name: str):
-    """A public name from its module, imported on first use (:data:`_LAZY`, PEP 562);
-    names this module had before the restructures, from their new places
-    (docs/architecture.md, "Moved names")."""
-    if name in _LAZY:
-        import importlib
+_MOVED = {
+    "GENERAL_OPTIONAL": "femmech.scene.load.GENERAL_OPTIONAL",
+    "InterfaceSpec": "femmech.scene.load.InterfaceSpec",
+    "ItemSpec": "femmech.scene.load.ItemSpec",
+    "MaterialSpec": "femmech.scene.load.MaterialSpec",
+    "PartSpec": "femmech.scene.load.PartSpec",
+    "REDUCTIONS": "femmech.scene.load.REDUCTIONS",
+    "ReductionSpec": "femmech.scene.load.ReductionSpec",
+    "SECTION_SHAPES": "femmech.scene.load.SECTION_SHAPES",
+    "SectionSpec": "femmech.scene.load.SectionSpec",
+    "ShellSpec": "femmech.scene.load.ShellSpec",
+    "SolidSpec": "femmech.scene.load.SolidSpec",
+}
+"""Names this package had before the restructures → their new places (docs/architecture.md,
+"Moved names")."""
 
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value  # later look-ups skip this function
-        return value
-    from femmech.deprecation import moved
-
-    return moved(__name__, name, {
-        "GENERAL_OPTIONAL": "femmech.scene.load.GENERAL_OPTIONAL",
-        "InterfaceSpec": "femmech.scene.load.InterfaceSpec",
-        "ItemSpec": "femmech.scene.load.ItemSpec",
-        "MaterialSpec": "femmech.scene.load.MaterialSpec",
-        "PartSpec": "femmech.scene.load.PartSpec",
-        "REDUCTIONS": "femmech.scene.load.REDUCTIONS",
-        "ReductionSpec": "femmech.scene.load.ReductionSpec",
-        "SECTION_SHAPES": "femmech.scene.load.SECTION_SHAPES",
-        "SectionSpec": "femmech.scene.load.SectionSpec",
-        "ShellSpec": "femmech.scene.load.ShellSpec",
-        "SolidSpec": "femmech.scene.load.SolidSpec",
-    })
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names(__name__, _LAZY, moved_names=_MOVED)
