@@ -320,10 +320,13 @@ def dynamics(out_dir="out/processing_machine", rpm: float = OPERATING_RPM,
     deg = np.rad2deg(r.phi)
     q = {f"cam{k + 1}.q": r.q[:, system.labels.index(f"cam{k + 1}.q")] for k in range(2)}
     force_curves = dict(zip(forces.labels, forces.forces.T, strict=True))
+    where = {"y_c": "at the cam bearing", "y_f": "at the return-spring base"}
     plot_time_histories(deg, {
-        "follower deformation q (µm)": {k: 1e6 * v for k, v in q.items()},
-        "shaft twist at cam (mrad)": {f"cam{k + 1}": 1e3 * twist[:, k] for k in range(2)},
-        "cam force on frame (N)": {k: f for k, f in force_curves.items() if "y_" in k},
+        "follower deformation q (µm)": {system.describe(k): 1e6 * v for k, v in q.items()},
+        "shaft twist at cam (mrad)": {f"cam {k + 1}": 1e3 * twist[:, k] for k in range(2)},
+        "cam force on frame (N)": {
+            f"cam {k[3]} {where[k.split('.')[1]]} [{k}]": f
+            for k, f in force_curves.items() if k.split(".")[-1] in where},
         "torque (N m)": {"motor (drive-end reaction)": motor,
                          "Σ cam drive rows (rigid shaft)": rows}},
         out / "steady_state.png", xlabel="drive angle φ (deg)",
