@@ -5,44 +5,13 @@ import sys
 from pathlib import Path
 
 import pytest
+from scene_texts import CRAIG_BAMPTON, frame_scene
 
 from femmech.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 
-SCENE = """
-[scene]
-name = "cli test"
-
-[materials.steel]
-E = "210 GPa"
-nu = 0.3
-rho = "7850 kg/m^3"
-
-[parts.frame.generator]
-kind = "grid_frame"
-bays = [1, 1, 1]
-size = [1.0, 0.6, 0.8]
-subdivisions = 2
-
-[parts.frame.sections]
-beams_x = { section = "circle", diameter = "40 mm", material = "steel" }
-beams_y = { section = "circle", diameter = "40 mm", material = "steel" }
-columns = { section = "circle", diameter = "50 mm", material = "steel" }
-
-[[parts.frame.supports]]
-nodes = "base"
-
-[parts.frame.reduction]
-method = "craig_bampton"
-n_modes = 6
-interface = [{ nodes = "top", dofs = "translations" }]
-
-[analyses.modes]
-n_modes = 4
-images = 0
-vtu = false
-"""
+SCENE = frame_scene("cli test", subdivisions=2, parts_extra=CRAIG_BAMPTON, n_modes=4)
 
 
 @pytest.fixture

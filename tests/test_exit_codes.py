@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scene_texts import frame_scene
 
 import femmech.scene.tasks as tasks
 from femmech.cli import EXIT_CODES, main
@@ -20,31 +21,7 @@ from femmech.cli import EXIT_CODES, main
 ROOT = Path(__file__).resolve().parent.parent
 ROW = re.compile(r"^\| (\d+) \| (.+) \|$", re.M)
 
-FRAME = """
-[scene]
-name = "frame"
-
-[materials.steel]
-E = "210 GPa"
-nu = 0.3
-rho = "7850 kg/m^3"
-
-[parts.frame]
-MESH
-
-[parts.frame.sections]
-beams_x = { section = "circle", diameter = "40 mm", material = "steel" }
-beams_y = { section = "circle", diameter = "40 mm", material = "steel" }
-columns = { section = "circle", diameter = "50 mm", material = "steel" }
-
-[[parts.frame.supports]]
-nodes = "base"
-
-[analyses.modes]
-n_modes = 3
-images = 0
-vtu = false
-"""
+FRAME = frame_scene(mesh_line="MESH")
 GENERATOR = ('generator = { kind = "grid_frame", bays = [1, 1, 1], size = [1.0, 0.6, 0.8],'
              ' subdivisions = 1 }')
 

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scene_texts import frame_scene
 
 import femmech.scene.tasks as tasks
 from femmech.cli import FILESYSTEM, INPUT, INTERNAL, NUMERICAL, main
@@ -22,34 +23,7 @@ from femmech.scene.run import run_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 
-FRAME = """
-[scene]
-name = "frame"
-
-[materials.steel]
-E = "210 GPa"
-nu = 0.3
-rho = "7850 kg/m^3"
-
-[parts.frame.generator]
-kind = "grid_frame"
-bays = [1, 1, 1]
-size = [1.0, 0.6, 0.8]
-subdivisions = 1
-
-[parts.frame.sections]
-beams_x = { section = "circle", diameter = "40 mm", material = "steel" }
-beams_y = { section = "circle", diameter = "40 mm", material = "steel" }
-columns = { section = "circle", diameter = "50 mm", material = "steel" }
-
-[[parts.frame.supports]]
-nodes = "base"
-
-[analyses.modes]
-n_modes = N_MODES
-images = IMAGES
-vtu = false
-"""
+FRAME = frame_scene(subdivisions=1, n_modes="N_MODES", images="IMAGES")
 
 # the processing machine of the chapter through a user module (the built-in made by user code)
 MECHANISM = """

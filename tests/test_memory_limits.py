@@ -9,6 +9,7 @@ import tomllib
 from pathlib import Path
 
 import pytest
+from scene_texts import frame_scene
 
 from femmech.cli import INPUT, main
 from femmech.errors import SceneError
@@ -20,33 +21,7 @@ from femmech.scene.memory import MEMORY_ENV, estimate_bytes, memory_limit
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
 
-GRID = """
-[scene]
-name = "a million joints"
-
-[materials.steel]
-E = "210 GPa"
-nu = 0.3
-rho = "7850 kg/m^3"
-
-[parts.frame.generator]
-kind = "grid_frame"
-bays = [100, 100, 99]
-size = [10.0, 10.0, 10.0]
-
-[parts.frame.sections]
-beams_x = { section = "circle", diameter = "40 mm", material = "steel" }
-beams_y = { section = "circle", diameter = "40 mm", material = "steel" }
-columns = { section = "circle", diameter = "50 mm", material = "steel" }
-
-[[parts.frame.supports]]
-nodes = "base"
-
-[analyses.modes]
-n_modes = 3
-images = 0
-vtu = false
-"""
+GRID = frame_scene("a million joints", bays=(100, 100, 99), size=(10.0, 10.0, 10.0))
 
 PLATE = """
 [scene]

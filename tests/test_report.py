@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scene_texts import frame_scene
 
 from femmech.analysis.modes import modes
 from femmech.analysis.participation import participation
@@ -23,30 +24,7 @@ from femmech.scene.run import run_scene
 ROOT = Path(__file__).resolve().parent.parent
 
 # A small frame (one mode image) and a mechanism alone (quasi-frequency diagram).
-SCENE = """
-[scene]
-name = "report test"
-description = "frame modes & a slider-crank <mechanism>"
-
-[materials.steel]
-E = "210 GPa"
-nu = 0.3
-rho = "7850 kg/m^3"
-
-[parts.frame.generator]
-kind = "grid_frame"
-bays = [1, 1, 1]
-size = [1.0, 0.6, 0.8]
-
-[parts.frame.sections]
-beams_x = { section = "circle", diameter = "40 mm", material = "steel" }
-beams_y = { section = "circle", diameter = "40 mm", material = "steel" }
-columns = { section = "circle", diameter = "50 mm", material = "steel" }
-
-[[parts.frame.supports]]
-nodes = "base"
-
-[mechanisms.press]
+PRESS = """[mechanisms.press]
 model = "table_5_1_case"
 options = { case = 1 }
 position_functions.U = { kind = "slider_crank", r = "50 mm", l = "350 mm" }
@@ -59,18 +37,15 @@ c2 = "1e9 N/m"
 b1 = 0
 b2 = 0
 F2 = 0
-
-[analyses.modes]
-n_modes = 3
-images = 1
-vtu = true
-
-[analyses.sweep]
+"""
+SWEEP = """[analyses.sweep]
 mechanism = "press"
 angles = { start = "0 deg", stop = "360 deg", n = 37 }
 n_modes = 2
 speeds = ["0 rpm", "300 rpm"]
 """
+SCENE = frame_scene("report test", description="frame modes & a slider-crank <mechanism>",
+                    parts_extra=PRESS, images=1, vtu=True, after=SWEEP)
 
 CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
                   "--no-first-run", "--disable-background-networking",
