@@ -42,7 +42,7 @@ from femmech.errors import InputError
 from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
 from femmech.fe.model import FEModel, node_index
 from femmech.html import html_summary
-from femmech.mechanisms.catalogue import describe
+from femmech.mechanisms.catalogue import coordinate_unit, describe
 from femmech.reduction.substructures import Assembly
 from femmech.reduction.superelement import Superelement
 
@@ -162,6 +162,17 @@ class CoupledSystem:
             if label.startswith(prefix) and label[len(prefix):]:
                 return describe(mount.model, label[len(prefix):], prefix)
         return label
+
+    def unit(self, label: str) -> str:
+        """SI unit of the mechanism coordinate ``label`` (``"m"``, ``"rad"``), from its
+        mechanism's labels and the catalogue (:func:`~femmech.mechanisms.catalogue.
+        coordinate_unit`); ``""`` for frame coordinates and where the mechanism does not
+        say."""
+        for mount in self.mounts:
+            prefix = f"{mount.name}."
+            if label.startswith(prefix) and label[len(prefix):]:
+                return coordinate_unit(mount.model, label[len(prefix):])
+        return ""
 
     @property
     def is_sparse(self) -> bool:

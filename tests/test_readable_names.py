@@ -33,16 +33,20 @@ def _press_run_up(tmp_path, monkeypatch):
                                      "outputs": ["press.q_t", "press.q"],
                                      "frame_dofs": [{"node": "guide", "dof": "ux"}]}}
     scene = Scene.from_dict(data, ROOT / "examples", "press_frame.toml")
-    ylabels = []
-    original = matplotlib.axes.Axes.set_ylabel
+    ylabels, titles = [], []
 
-    def record(self, label, *args, **kwargs):
-        ylabels.append(label)
-        return original(self, label, *args, **kwargs)
+    def recorder(name, into):
+        original = getattr(matplotlib.axes.Axes, name)
 
-    monkeypatch.setattr(matplotlib.axes.Axes, "set_ylabel", record)
+        def record(self, label, *args, **kwargs):
+            into.append(label)
+            return original(self, label, *args, **kwargs)
+        monkeypatch.setattr(matplotlib.axes.Axes, name, record)
+
+    recorder("set_ylabel", ylabels)
+    recorder("set_title", titles)
     result = run_scene(scene, tmp_path, cache_dir=None)
-    return result, ylabels
+    return result, ylabels, titles
 
 
 def _cells(html: str, caption: str) -> list[list[str]]:
@@ -53,14 +57,17 @@ def _cells(html: str, caption: str) -> list[list[str]]:
 
 def test_response_table_and_plot_use_readable_names_and_csv_the_raw_ones(tmp_path,
                                                                          monkeypatch):
-    result, ylabels = _press_run_up(tmp_path, monkeypatch)
+    result, ylabels, titles = _press_run_up(tmp_path, monkeypatch)
     html = result.report.read_text(encoding="utf-8")
     rows = _cells(html, "Amplitudes (m, rad or modal)")
     assert [r[0] for r in rows] == ["crankshaft twist [press.q_t]",
                                     "output (rod and ram) deformation [press.q]",
                                     "frame:guide:ux"]
-    assert "crankshaft twist [press.q_t]\n(m or rad)" in ylabels
-    assert "output (rod and ram) deformation [press.q]\n(m or rad)" in ylabels
+    # panels are titled by the readable name; the y axis has the coordinate's unit (the
+    # catalogue: q_t is a twist in rad, q a deformation in m), a frame DOF its own
+    assert titles == ["crankshaft twist [press.q_t]",
+                      "output (rod and ram) deformation [press.q]", "frame:guide:ux"]
+    assert ylabels == ["rad", "m", "m"]
     with open(tmp_path / "response.csv", newline="") as f:
         header = next(csv.reader(f))
     assert header == ["t_s", "phi_rad", "press.q_t", "press.q", "frame:guide:ux"]
@@ -93,3 +100,5 @@ def test_coupled_system_describes_its_labels():
         "shaft twist at the cam [cam1.q_s]", "cam-centre displacement [cam1.y_c]",
         "return-spring base displacement [cam1.y_f]", "follower deformation [cam1.q]"]
     assert system.describe("frame 3") == "frame 3"
+    assert [system.unit(label) for label in own] == ["rad", "m", "m", "m"]
+    assert system.unit("frame 3") == ""

@@ -17,8 +17,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["CATALOGUE", "Coordinate", "Entry", "Parameter", "coordinate_labels", "describe",
-           "readable"]
+__all__ = ["CATALOGUE", "Coordinate", "Entry", "Parameter", "coordinate_labels",
+           "coordinate_unit", "describe", "readable"]
 
 
 @dataclass(frozen=True)
@@ -314,6 +314,19 @@ def describe(model, name: str, prefix: str = "") -> str:
     mechanism = getattr(model, "mechanism", model)
     meaning = dict(getattr(mechanism, "labels", ())).get(name, "")
     return readable(meaning, prefix + name)
+
+
+def coordinate_unit(model, name: str) -> str:
+    """SI unit of coordinate ``name`` of ``model`` (a Mechanism, or a model with a
+    ``mechanism``): that of the catalogue coordinate with the same name and meaning
+    (``"m"``, ``"rad"``); ``""`` where the mechanism's labels do not say (user mechanisms)."""
+    mechanism = getattr(model, "mechanism", model)
+    meaning = dict(getattr(mechanism, "labels", ())).get(name)
+    if meaning is None:
+        return ""
+    units = {c.unit for e in CATALOGUE.values() for c in e.coordinates
+             if c.name == name and c.meaning == meaning}
+    return units.pop() if len(units) == 1 else ""
 
 
 def _anchor(heading: str) -> str:

@@ -346,7 +346,8 @@ def run_response(ws, spec, out):
              f"Run-up {format_speed(spec.speed_start, spec.speed_unit)} →"
              f" {format_speed(spec.speed_end, spec.speed_unit)} in {spec.duration:g} s")
     shown = {k: system.describe(k) for k in columns}  # HTML and plot; the CSV keeps k
-    _plot_response(r, columns, spec.kind, out / "response.png", title, shown)
+    _plot_response(r, columns, spec.kind, out / "response.png", title, shown,
+                   {k: system.unit(k) for k in columns})
     loose = r.converged is False
 
     def cell(x):
@@ -383,15 +384,17 @@ def run_response(ws, spec, out):
     return section, summary
 
 
-def _response_unit(name: str) -> str:
+def _response_unit(name: str, units=None) -> str:
     """Unit of a response column: frame DOFs ``part:node:dof`` are m (u*) or rad (r*);
-    mechanism coordinates are in the mechanism's SI units (m or rad)."""
+    mechanism coordinates that of ``units`` (column → unit, from the catalogue), else
+    "m or rad" (a user mechanism's SI unit)."""
     dof = name.rsplit(":", 1)[-1] if name.count(":") == 2 else ""
-    return {"u": "m", "r": "rad"}.get(dof[:1], "m or rad")
+    return {"u": "m", "r": "rad"}.get(dof[:1]) or (units or {}).get(name) or "m or rad"
 
 
-def _plot_response(r, columns, kind, path, title: str = "", shown=None) -> None:
-    """One panel per column; y labels from ``shown`` (column → readable name)."""
+def _plot_response(r, columns, kind, path, title: str = "", shown=None, units=None) -> None:
+    """One panel per column, titled by ``shown`` (column → readable name); the y axis
+    carries the unit (``units``: column → unit of a mechanism coordinate)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure as MplFigure
 
@@ -404,7 +407,8 @@ def _plot_response(r, columns, kind, path, title: str = "", shown=None) -> None:
     for i, (name, values) in enumerate(columns.items() or {"(none)": 0 * x}.items()):
         ax = fig.add_subplot(max(1, len(columns)), 1, i + 1)
         ax.plot(x, values, lw=1.0)
-        ax.set_ylabel(f"{(shown or {}).get(name, name)}\n({_response_unit(name)})", fontsize=8)
+        ax.set_title((shown or {}).get(name, name), loc="left", fontsize=9)
+        ax.set_ylabel(_response_unit(name, units), fontsize=8)
         ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3), useMathText=True)
         ax.grid(alpha=0.3)
         if kind == "periodic":
