@@ -137,6 +137,3 @@ def _replace(out: Path, staging: Path, token: str) -> None:
         return
     ours = run_files(out)
     swap(out, staging, token, ours, list(user_items(out, ours)))
-def _listed(paths: list[str], at_most: int = 10) -> str:
-    more = len(paths) - at_most
-    return ", ".join(paths[:at_most]) + (f" and {more} more" if more > 0 else "")
