@@ -157,22 +157,26 @@ class CoupledSystem:
         """Readable name of the global coordinate ``label`` (one of :attr:`labels`): a
         mechanism coordinate as ``"follower deformation [cam1.q]"`` (its mechanism's
         ``labels``, :func:`femmech.mechanisms.catalogue.describe`); others unchanged."""
-        for mount in self.mounts:
-            prefix = f"{mount.name}."
-            if label.startswith(prefix) and label[len(prefix):]:
-                return describe(mount.model, label[len(prefix):], prefix)
-        return label
+        found = self._mount_coordinate(label)
+        return label if found is None else describe(found[0].model, found[1],
+                                                     f"{found[0].name}.")
 
     def unit(self, label: str) -> str:
         """SI unit of the mechanism coordinate ``label`` (``"m"``, ``"rad"``), from its
         mechanism's labels and the catalogue (:func:`~femmech.mechanisms.catalogue.
         coordinate_unit`); ``""`` for frame coordinates and where the mechanism does not
         say."""
+        found = self._mount_coordinate(label)
+        return "" if found is None else coordinate_unit(found[0].model, found[1])
+
+    def _mount_coordinate(self, label: str):
+        """``(mount, coordinate name)`` of a mechanism coordinate ``label``
+        (``"cam1.q"``), None for a frame coordinate."""
         for mount in self.mounts:
             prefix = f"{mount.name}."
             if label.startswith(prefix) and label[len(prefix):]:
-                return coordinate_unit(mount.model, label[len(prefix):])
-        return ""
+                return mount, label[len(prefix):]
+        return None
 
     @property
     def is_sparse(self) -> bool:

@@ -311,17 +311,21 @@ def describe(model, name: str, prefix: str = "") -> str:
     ``mechanism``), e.g. ``describe(model, "y_f", "cam1.")`` → ``"return-spring base
     displacement [cam1.y_f]"``; the raw ``prefix + name`` where the mechanism says nothing
     about it (user mechanisms without labels)."""
+    return readable(_meaning(model, name) or "", prefix + name)
+
+
+def _meaning(model, name: str) -> str | None:
+    """The meaning the mechanism of ``model`` gives coordinate ``name`` (its ``labels``),
+    None if it gives none."""
     mechanism = getattr(model, "mechanism", model)
-    meaning = dict(getattr(mechanism, "labels", ())).get(name, "")
-    return readable(meaning, prefix + name)
+    return dict(getattr(mechanism, "labels", ())).get(name)
 
 
 def coordinate_unit(model, name: str) -> str:
     """SI unit of coordinate ``name`` of ``model`` (a Mechanism, or a model with a
     ``mechanism``): that of the catalogue coordinate with the same name and meaning
     (``"m"``, ``"rad"``); ``""`` where the mechanism's labels do not say (user mechanisms)."""
-    mechanism = getattr(model, "mechanism", model)
-    meaning = dict(getattr(mechanism, "labels", ())).get(name)
+    meaning = _meaning(model, name)
     if meaning is None:
         return ""
     units = {c.unit for e in CATALOGUE.values() for c in e.coordinates
