@@ -91,3 +91,12 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if "heavy" in item.keywords:
             item.add_marker(skip)
+
+
+@pytest.fixture(scope="module")
+def damped_cam_system():
+    """The damped Table 5.1 cam on the simply supported beam (``models.damped_cam_on_beam``),
+    built once per test module."""
+    from models import damped_cam_on_beam
+
+    return damped_cam_on_beam()

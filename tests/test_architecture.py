@@ -8,7 +8,8 @@ deferred import cannot hide a circle) and checks that
 * nothing inside femmech imports the top-level package (it re-exports, it is not a layer);
 * old paths (module files kept only so that names moved by a restructure still import,
   docs/architecture.md "Moved names") import nothing but :mod:`femmech.deprecation`, and
-  nothing inside femmech imports them: they stand outside the stages.
+  nothing inside femmech imports them: they stand outside the stages;
+* no test file imports another test file: shared test models live in helper modules.
 """
 
 from __future__ import annotations
@@ -187,6 +188,35 @@ def test_stage_order():
 def test_cycle_finder(graph, expected):
     """The checker itself finds a circle of three and none in a chain."""
     assert cycles(graph) == expected
+
+
+# --- test files share models through helper modules, never through each other ------------
+
+TESTS = Path(__file__).resolve().parent
+SHARED_TEST_MODULES = frozenset({"models", "scene_texts", "roundoff", "hard_models"})
+"""The helper modules of tests/ that test files import (shared models, scene texts,
+round-off bounds, the hard cases' models); ``conftest.py`` serves fixtures."""
+
+
+def test_files_import_no_other_test_file():
+    """A test file imports only the shared helper modules of tests/, never another test
+    file, so that moving or renaming a test does not break its neighbours."""
+    local = {path.stem for path in TESTS.rglob("*.py")} | {"tests"}
+    wrong = []
+    for path in sorted(TESTS.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                names = ["." * node.level + (node.module or "")]
+            else:
+                continue
+            for name in names:
+                head = name.split(".")[0]
+                if name.startswith(".") or (head in local and head not in SHARED_TEST_MODULES):
+                    wrong.append(f"{path.relative_to(TESTS)} imports {name}")
+    assert {"models", "hard_models"} <= local  # the helpers exist where listed
+    assert not wrong, "\n".join(wrong)
 
 
 # --- adding an element type touches only femmech/fe/elements/ plus its registration ---
