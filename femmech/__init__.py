@@ -45,6 +45,19 @@ _LAZY = {
     "build_model": "femmech.fe.model",
     "refine_mesh": "femmech.fe.refine",
     "BeamSection": "femmech.fe.sections",
+    # the main verbs of the data flow: reduce, couple, sweep, judge stability, respond, run
+    "craig_bampton": "femmech.reduction",
+    "guyan": "femmech.reduction",
+    "rheolinear": "femmech.mechanisms",
+    "Attachment": "femmech.coupling",
+    "Mount": "femmech.coupling",
+    "couple": "femmech.coupling",
+    "sweep": "femmech.analysis.sweep",
+    "speed_study": "femmech.analysis.stability",
+    "stability_chart": "femmech.analysis.stability",
+    "periodic_steady_state": "femmech.analysis.response",
+    "load_scene": "femmech.scene",
+    "run_scene": "femmech.scene",
 }
 """Public name → the module it lives in, imported on first use (PEP 562), so that
 ``import femmech`` (and every ``python -m femmech`` command, e.g. ``femmech check``)
@@ -84,6 +97,18 @@ __all__ = [
     "modes",
     "read_mesh",
     "refine_mesh",
+    "Attachment",
+    "Mount",
+    "couple",
+    "craig_bampton",
+    "guyan",
+    "load_scene",
+    "periodic_steady_state",
+    "rheolinear",
+    "run_scene",
+    "speed_study",
+    "stability_chart",
+    "sweep",
 ]
 
 

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 import sympy
+from models import CAM, PARAMS, cam_mechanism, simply_supported_beam
 from numpy.testing import assert_allclose
 
 import femmech as fm
@@ -16,7 +17,6 @@ from femmech.mechanisms import (
     Mechanism,
     PointMass,
     Potential,
-    RotaryInertia,
     Spring,
     polynomial_345,
     position_function,
@@ -27,50 +27,22 @@ from femmech.reduction.component_modes import craig_bampton
 from femmech.solve.eigen import solve_symmetric
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
-PARAMS = {"J1": 0.05, "m2": 3.0, "c1": 2e4, "c2": 5e5}
-CAM = CamProfile((CamSegment(np.pi / 2, 0.02, polynomial_345()), CamSegment(np.pi / 2, 0.0),
-                  CamSegment(np.pi / 2, -0.02, polynomial_345()), CamSegment(np.pi / 2, 0.0)))
 PHI = np.linspace(0.0, 2 * np.pi, 73)
-
-
-def _cam_mechanism(with_guide: bool):
-    """Table 5.1 case 1 (shaft twist q1, follower deflection q2), optionally with the
-    follower guide displacement y_g of the frame as a further coordinate:
-    x2 = y_g + U(θ + q1) + q2, 2T = J1 (θ' + q1')² + m2 x2'², 2V = c1 q1² + c2 q2²."""
-    theta, q1, yg, q2 = sympy.symbols("theta q1 y_g q2")
-    J1, m2, c1, c2 = sympy.symbols("J1 m2 c1 c2")
-    U = position_function("U")
-    x2 = (yg if with_guide else 0) + U(theta + q1) + q2
-    coords = (q1, yg, q2, theta) if with_guide else (q1, q2, theta)
-    return Mechanism(coords, (RotaryInertia(J1, theta + q1), PointMass(m2, (x2,)),
-                              Spring(c1, q1), Spring(c2, q2)), drives=(theta,))
-
-
-def _beam(E=210e9, n=40):
-    """Simply supported 1 m beam along x (uy bending carries the cam guide at mid-span)."""
-    x = np.linspace(0.0, 1.0, n + 1)
-    mesh = fm.Mesh.from_lines(np.column_stack([x, 0 * x, 0 * x]),
-                              np.column_stack([np.arange(n), np.arange(1, n + 1)]),
-                              node_sets={"ends": [0, n], "mid": [n // 2]})
-    material = fm.Material(E=E, nu=0.3, rho=7850.0)
-    prop = fm.BeamProperty(sections.rectangular_hollow(0.06, 0.08, 0.004), material)
-    return fm.build_model(mesh, {"all": prop}, supports=[
-        fm.Support("ends", "translations"), fm.Support(0, ["rx"])])
 
 
 @pytest.fixture(scope="module")
 def cam_model():
-    return rheolinear(_cam_mechanism(True), PARAMS, {"U": CAM})
+    return rheolinear(cam_mechanism(True), PARAMS, {"U": CAM})
 
 
 def test_rigidly_held_guide_reproduces_mechanism_alone(cam_model):
     # Guide attached at a supported node (uy fixed): y_g = 0 exactly, so the coupled
     # spectrum is the union of the frame's and the mechanism-alone quasi-frequencies
     # (quasi_modes on Table 5.1 case 1); dense LAPACK on both: round-off.
-    fe = _beam()
+    fe = simply_supported_beam()
     se = craig_bampton(fe, "mid", n_modes=10)
     system = couple(se, [Mount(cam_model, (Attachment("y_g", 0, "uy"),), name="cam")])
-    alone = quasi_modes(rheolinear(_cam_mechanism(False), PARAMS, {"U": CAM}), PHI)
+    alone = quasi_modes(rheolinear(cam_mechanism(False), PARAMS, {"U": CAM}), PHI)
     frame = np.sqrt(sla.eigh(se.K, se.M, eigvals_only=True)[:4]) / (2 * np.pi)
     result = sweep(system, PHI, n_modes=6, track=False)
     for a in range(PHI.size):
@@ -83,10 +55,10 @@ def test_stiff_frame_converges_to_mechanism_alone(cam_model):
     # A frame 100 and 1000 times stiffer: the mechanism branches approach the
     # mechanism-alone values with an error falling like 1/stiffness. (Much stiffer
     # frames hit round-off: dense eigh resolves λ_min to ~eps·λ_max/λ_min ~ 1e-6 at 1e6.)
-    alone = quasi_modes(rheolinear(_cam_mechanism(False), PARAMS, {"U": CAM}), PHI[:10])
+    alone = quasi_modes(rheolinear(cam_mechanism(False), PARAMS, {"U": CAM}), PHI[:10])
     errors = []
     for factor in (1e2, 1e3):
-        se = craig_bampton(_beam(E=210e9 * factor), "mid", n_modes=6)
+        se = craig_bampton(simply_supported_beam(E=210e9 * factor), "mid", n_modes=6)
         system = couple(se, [Mount(cam_model, (Attachment("y_g", 20, "uy"),), name="cam")])
         result = sweep(system, PHI[:10], n_modes=2, track=False)
         errors.append(np.abs(result.freq_hz / alone.freq_hz[:, :2] - 1).max())
@@ -97,7 +69,7 @@ def test_stiff_frame_converges_to_mechanism_alone(cam_model):
 def test_reduced_coupled_matches_full_coupled(cam_model):
     # Craig-Bampton (residual vectors) frame vs the unreduced FE frame in the same
     # coupled system, at angles in dwell and rise: frequencies and mode shapes.
-    fe = _beam()
+    fe = simply_supported_beam()
     mount = lambda node: Mount(cam_model, (Attachment("y_g", node, "uy"),), name="cam")  # noqa: E731
     reduced = couple(craig_bampton(fe, "mid", n_modes=10), [mount(20)])
     full = couple(fe, [mount("mid")])
@@ -119,7 +91,7 @@ def test_reduced_coupled_matches_full_coupled(cam_model):
 def test_elastic_attachment_tends_to_rigid(cam_model):
     # A bearing spring k between the guide coordinate and the frame: as k grows the
     # frequencies approach the rigid attachment's, with error ~ 1/k.
-    se = craig_bampton(_beam(), "mid", n_modes=10)
+    se = craig_bampton(simply_supported_beam(), "mid", n_modes=10)
     rigid = sweep(couple(se, [Mount(cam_model, (Attachment("y_g", 20, "uy"),))]), PHI[:5],
                   n_modes=5, track=False).freq_hz
     errors = []
@@ -189,10 +161,10 @@ def test_sensitivity_matches_finite_differences(cam_model):
     # ~1e-12/1e-4): agreement to 1e-5 relative; a mode c2 hardly affects has df ~ 0,
     # where the FD quotient is noise: f resolved to ~1e-12 relative over 2h = 100 N/m
     # gives ~2e-12 Hz/(N/m), so atol = 1e-7 max|df| (5e-12).
-    se = craig_bampton(_beam(), "mid", n_modes=10)
+    se = craig_bampton(simply_supported_beam(), "mid", n_modes=10)
 
     def build(c2):
-        model = rheolinear(_cam_mechanism(True), {**PARAMS, "c2": c2}, {"U": CAM})
+        model = rheolinear(cam_mechanism(True), {**PARAMS, "c2": c2}, {"U": CAM})
         return couple(se, [Mount(model, (Attachment("y_g", 20, "uy"),))])
 
     c2, phi = PARAMS["c2"], 0.6
@@ -211,7 +183,7 @@ def _mbc(system, phi):
 
 def test_damped_form_reduces_to_undamped_without_damping(cam_model):
     # With B = 0 the first-order form gives s = ±iω: the same frequencies, zero damping.
-    se = craig_bampton(_beam(), "mid", n_modes=6)
+    se = craig_bampton(simply_supported_beam(), "mid", n_modes=6)
     system = couple(se, [Mount(cam_model, (Attachment("y_g", 20, "uy"),))])
     M, B, C, _ = system.matrices(0.4)
     undamped = frozen_modes(M, B, C, 4)
@@ -221,7 +193,7 @@ def test_damped_form_reduces_to_undamped_without_damping(cam_model):
 
 
 def test_attachment_errors(cam_model):
-    se = craig_bampton(_beam(), "mid", n_modes=4)
+    se = craig_bampton(simply_supported_beam(), "mid", n_modes=4)
     with pytest.raises(ValueError, match="unknown coordinate 'y'"):
         couple(se, [Mount(cam_model, (Attachment("y", 20, "uy"),), name="cam")])
     with pytest.raises(ValueError, match="attached twice"):
@@ -234,7 +206,7 @@ def test_multiplier_form_equals_primal(cam_model):
     # Seed 5.2.1 eq. 21: keeping the guide coordinate and enforcing y_g = u_frame by a
     # multiplier gives the same quasi-modes as eliminating it (QZ vs Cholesky-based
     # LAPACK on the same physics: round-off, ~1e-9 relative for these pencils).
-    se = craig_bampton(_beam(), "mid", n_modes=8)
+    se = craig_bampton(simply_supported_beam(), "mid", n_modes=8)
     mount = Mount(cam_model, (Attachment("y_g", 20, "uy"),), name="cam")
     primal = sweep(couple(se, [mount]), PHI[::6], n_modes=5, track=False)
     system = couple(se, [mount], form="multiplier")
@@ -252,7 +224,7 @@ def test_speed_sweep_tracks_unsymmetric_stiffness(cam_model):
     # with Ω (tracked branches: small steps, MAC steps ~ 1).
     from femmech.analysis.sweep import parameter_sweep
 
-    se = craig_bampton(_beam(), "mid", n_modes=8)
+    se = craig_bampton(simply_supported_beam(), "mid", n_modes=8)
     system = couple(se, [Mount(cam_model, (Attachment("y_g", 20, "uy"),), name="cam")])
     speeds = np.linspace(0.0, 60.0, 31)  # rad/s
     result = parameter_sweep(lambda W: (system, W), speeds, phi=0.6, n_modes=4)
@@ -296,7 +268,7 @@ def test_assembly_frame_equals_single_superelement(cam_model):
     from femmech.fe.mesh import line_submesh
     from femmech.reduction.substructures import assemble_parts
 
-    fe = _beam()
+    fe = simply_supported_beam()
     mesh = fe.mesh
     left = mesh.points[mesh.cells["line"]].mean(axis=1)[:, 0] < 0.5
     parts = []
@@ -330,7 +302,7 @@ def test_batched_angle_matrices_equal_per_angle_assembly(cam_model):
     from femmech.analysis.sweep import _angle_matrices
     from femmech.coupling import assemble_at
 
-    se = craig_bampton(_beam(), "mid", n_modes=6)
+    se = craig_bampton(simply_supported_beam(), "mid", n_modes=6)
     system = couple(se, [
         Mount(cam_model, (Attachment("y_g", 20, "uy"),), name="a"),
         Mount(cam_model, (Attachment("y_g", 20, "uy", stiffness=1e8, damping=50.0),),
@@ -426,7 +398,7 @@ def test_sweep_threads_follow_femmech_threads(monkeypatch, cam_model):
 
     import femmech.analysis.sweep as sweep_module
     from femmech.solve import threads
-    system = couple(craig_bampton(_beam(), "mid", n_modes=6),
+    system = couple(craig_bampton(simply_supported_beam(), "mid", n_modes=6),
                     [Mount(cam_model, (Attachment("y_g", 20, "uy"),))])
     seen, solve = [], sweep_module.frozen_modes
 

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from models import OLD_PEAK, OLD_T_TRIP
 from numpy.testing import assert_allclose
-from test_drive_events import OLD_PEAK, OLD_T_TRIP
 
 from femmech.analysis.nonlinear import integrate_second_kind
 from femmech.analysis.response import SpeedRamp

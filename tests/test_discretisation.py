@@ -13,6 +13,7 @@ extrapolated.
 import numpy as np
 import pytest
 import scipy.linalg as sl
+from models import plate_cells
 
 import femmech as fm
 from femmech.analysis.discretisation import RATES, discretisation_error, match_modes
@@ -110,32 +111,6 @@ def test_timoshenko_simply_supported_against_navier_solution():
     assert list(est.flag) == ["", "", "", "not asymptotic"]
     ratio = within_factor(est.error, truth, est.trusted)
     assert np.all(ratio > 0.95)  # measured 1.03-1.05
-
-
-def plate_cells(n, kind):
-    """Points and cells of n x n elements of ``kind`` on the unit square (quadratic kinds
-    on the (2n + 1)² grid of their nodes)."""
-    p = 2 if kind in ("quad9", "triangle6") else 1
-    X, Y = np.meshgrid(np.linspace(0, 1, p * n + 1), np.linspace(0, 1, p * n + 1))
-    points = np.column_stack([X.ravel(), Y.ravel(), np.zeros(X.size)])
-    i = np.arange(X.size).reshape(p * n + 1, p * n + 1)
-    if p == 1:
-        quads = np.column_stack([i[:-1, :-1].ravel(), i[:-1, 1:].ravel(), i[1:, 1:].ravel(),
-                                 i[1:, :-1].ravel()])
-        if kind == "quad":
-            return points, quads
-        flip = ((np.arange(n)[:, None] + np.arange(n)) % 2).ravel().astype(bool)
-        t1 = np.where(flip[:, None], quads[:, [0, 1, 3]], quads[:, [0, 1, 2]])
-        t2 = np.where(flip[:, None], quads[:, [1, 2, 3]], quads[:, [0, 2, 3]])
-        return points, np.vstack([t1, t2])
-    b = i[:-1:2, :-1:2].ravel()  # lower-left corner of each 2 x 2 block of nodes
-    w = p * n + 1
-    q9 = np.column_stack([b, b + 2, b + 2 + 2 * w, b + 2 * w, b + 1, b + 2 + w, b + 1 + 2 * w,
-                          b + w, b + 1 + w])
-    if kind == "quad9":
-        return points, q9
-    # two triangle6 per block, split along the diagonal 0-2 of the block
-    return points, np.vstack([q9[:, [0, 1, 2, 4, 5, 8]], q9[:, [0, 2, 3, 8, 6, 7]]])
 
 
 def plate_model(n, tri=False, t=0.01, kind=None):

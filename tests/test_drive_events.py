@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 import sympy
+from models import OLD_PEAK, OLD_T_TRIP
 from numpy.testing import assert_allclose
 
 from femmech.analysis.drive_events import (
@@ -39,8 +40,6 @@ T2 = 2 * 2 * np.pi * np.sqrt(P["rS5"] / P["g"])  # two pendulum periods, s
 CRANE = dict(drive="q4", start=4.7, speed=-0.1, ramp_time=T2, limit=300e3, t_after=T2,
              end=2.6, max_step=0.05, rtol=1e-10, atol=1e-12)
 # Measured with the example's own implementation (commit 645c8b2, same model and settings):
-OLD_T_TRIP = 13.793197428431492  # s
-OLD_PEAK = {0.2: 390602.53763092135, 0.5: 390388.4588700416, 1.0: 382467.5094894752}  # N
 OLD_STATIC_END = {0.2: 302567.50637064717}  # N, quasi-static Q4 at the final rest
 OLD_REST = [-0.11790279264744541, 0.013811170589781608, 0.0, 4.7]  # static rest at 4.7 m
 

@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 import sympy
+from models import simply_supported_beam  # simply supported 1 m beam, uy bending
 from numpy.testing import assert_allclose
-from test_stability import _beam  # simply supported 1 m beam, uy bending
 
 import femmech as fm
 from femmech.analysis.floquet import coupled_floquet, coupled_monodromy, monodromy
@@ -110,7 +110,7 @@ def test_mechanism_breakpoints_follow_the_argument_of_the_position_function():
 @pytest.fixture(scope="module")
 def cam_machine():
     """The cam follower on a simply supported beam (tests/test_stability.py), damped."""
-    system = couple(craig_bampton(_beam(20), "mid", n_modes=4),
+    system = couple(craig_bampton(simply_supported_beam(20), "mid", n_modes=4),
                     [Mount(_cam_model(cam=OFFSET_CAM), (Attachment("y_g", 10, "uy"),),
                            name="cam")])
     return rayleigh_damping(system, 1.0, 1e-5)

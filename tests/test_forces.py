@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 import sympy
+from models import CAM, PARAMS, cam_mechanism, simply_supported_beam
 from numpy.testing import assert_allclose
-from test_coupling import CAM, PARAMS, _beam, _cam_mechanism
 
 from femmech.analysis.forces import attachment_forces, drive_forces
 from femmech.analysis.response import (
@@ -44,7 +44,7 @@ def _guided_cam_model():
 
 @pytest.fixture(scope="module")
 def frame():
-    fe = _beam()
+    fe = simply_supported_beam()
     return fe, craig_bampton(fe, "mid", n_modes=10)
 
 
@@ -99,7 +99,7 @@ def test_rigid_attachment_force_is_limit_of_stiff_bearing(frame):
 def test_drive_torque_of_rigid_motion_is_cam_inertia_torque():
     # Table 5.1 case 1 (seed 5.2.2): at constant speed and q = 0 the drive row of the
     # 2nd-kind equations is d/dt ∂T/∂θ' = m2 U' U'' Ω² (J1 turns uniformly)
-    lagrange = second_kind(_cam_mechanism(False), PARAMS, {"U": CAM})
+    lagrange = second_kind(cam_mechanism(False), PARAMS, {"U": CAM})
     t = np.linspace(0.0, 2 * np.pi / W, 97)
     zeros = np.zeros((t.size, 2))
     r = Response(t, zeros, zeros, zeros, W * t)

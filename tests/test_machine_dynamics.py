@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy
+from models import PARAMS, simply_supported_beam
 from numpy.testing import assert_allclose
 from scipy.integrate import cumulative_simpson, solve_ivp
-from test_stability import PARAMS, _beam, damped_cam_system  # noqa: F401 (fixture)
 
 from femmech.analysis.floquet import coupled_monodromy, floquet, quasi_modal_basis
 from femmech.analysis.forces import drive_forces, support_reactions
@@ -75,7 +75,7 @@ def test_crane_cylinder_force_balances_the_power_flow():
 # --- coupled Floquet multipliers vs direct integration (acceptance) ---------------------
 
 @pytest.fixture(scope="module")
-def small_cam_system(damped_cam_system):  # noqa: F811
+def small_cam_system(damped_cam_system):
     """The damped cam on the beam with a harmonic cam (rise and return by half cosines:
     a full cosine, smooth in all derivatives) and the beam reduced to 2 fixed-interface
     modes at the guide's uy (5 coordinates, highest frame frequency 677 Hz), so that an
@@ -83,7 +83,8 @@ def small_cam_system(damped_cam_system):  # noqa: F811
     mech = damped_cam_system.mounts[0].model.mechanism
     cam = CamProfile((CamSegment(np.pi, 0.02, harmonic()), CamSegment(np.pi, -0.02, harmonic())))
     model = rheolinear(mech, {**PARAMS, "d1": 2.0, "d2": 80.0}, {"U": cam})
-    se = craig_bampton(_beam(), [("mid", ["uy"])], n_modes=2, residual_vectors=False)
+    se = craig_bampton(simply_supported_beam(), [("mid", ["uy"])], n_modes=2,
+                       residual_vectors=False)
     system = couple(se, [Mount(model, (Attachment("y_g", 20, "uy"),), name="cam")])
     return dataclasses.replace(system, B0=system.B0 + 1.0 * system.M0 + 1e-5 * system.K0)
 
@@ -116,7 +117,7 @@ def test_coupled_multipliers_match_direct_integration(small_cam_system):
     assert 0.1 < np.abs(mu).max() < 1  # damped, yet not decayed to nothing in one period
 
 
-def test_ritz_basis_monodromy_converges(damped_cam_system):  # noqa: F811
+def test_ritz_basis_monodromy_converges(damped_cam_system):
     # The full monodromy (all 20 coupled coordinates, residual-vector modes included) is
     # the reference; the projected one keeps the lowest quasi-modes at 8 angles. The
     # spectral radius belongs to the least damped slow motion, so a few modes suffice.
@@ -139,7 +140,7 @@ def test_ritz_basis_monodromy_converges(damped_cam_system):  # noqa: F811
     assert max(errors[1:]) < 5e-6
 
 
-def test_basis_errors(damped_cam_system):  # noqa: F811
+def test_basis_errors(damped_cam_system):
     system = damped_cam_system
     with pytest.raises(ValueError, match="basis must have shape"):
         coupled_monodromy(system, 30.0, 8, basis=np.ones((3, 2)))

@@ -10,7 +10,7 @@ is checked against code that does not share the new kernels.
 
 import numpy as np
 import scipy.linalg as sla
-from test_stability import _hill_2dof  # the 2-DOF Hill system with gyroscopic damping
+from models import hill_2dof  # the 2-DOF Hill system with gyroscopic damping
 
 from femmech.analysis import magnus
 from femmech.analysis.floquet import monodromy, monodromy_record
@@ -109,7 +109,7 @@ def test_agrees_with_the_old_integrator_where_it_was_accurate():
     # balancing, block commutator, batched products) and the old integrator (scipy expm
     # of every unbalanced step exponent) agree to round-off of the product: 1e-12
     # relative to ‖Φ‖ (measured 1e-15).
-    M, B, C, T = _hill_2dof()
+    M, B, C, T = hill_2dof()
     for n in (16, 64):
         new = monodromy(M, B, C, T, n, rtol=None)
         old = _reference_magnus(M, B, C, T, n)
@@ -145,7 +145,7 @@ def test_batched_levels_equal_levels_one_at_a_time():
     # is taken from the first batch, which may differ: required 1e-13 relative to ‖Φ‖,
     # measured 0 at 64 steps), and the record's error is the difference of the last two
     # levels, recomputed one at a time.
-    M, B, C, T = _hill_2dof()
+    M, B, C, T = hill_2dof()
     record = monodromy_record(M, B, C, T, 16, 1e-6, 2**12)
     assert record.converged
     fixed = [monodromy(M, B, C, T, record.n_steps // f, rtol=None) for f in (2, 1)]

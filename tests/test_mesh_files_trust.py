@@ -10,6 +10,7 @@ import warnings
 import meshio
 import numpy as np
 import pytest
+from models import cbar_card, deck, grid_card
 from numpy.testing import assert_array_equal
 
 import femmech as fm
@@ -19,29 +20,6 @@ from femmech.fe import sections
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0, name="steel")
 BAR = fm.BeamProperty(sections.rectangle(0.05, 0.08), STEEL, (0, 1, 0))
-
-
-def _field(value) -> str:
-    return f"{value!s:<8}"
-
-
-def grid_card(gid, x, cd="", ps="") -> str:
-    """A small-field GRID: ID, CP, X1-X3, CD, PS (fields 2-8)."""
-    return "GRID    " + "".join(_field(v) for v in (gid, "", x, 0.0, 0.0, cd, ps)) + "\n"
-
-
-def cbar_card(eid, a, b, pid=1) -> str:
-    return "CBAR    " + "".join(_field(v) for v in (eid, pid, a, b, "0.", "1.", "0.")) + "\n"
-
-
-def deck(tmp_path, extra="", grids=None, bars=None, name="frame.bdf"):
-    """A cantilever of 4 CBARs along x (GRIDs 1-5, 0.5 m apart), plus ``extra`` cards."""
-    grids = grids if grids is not None else "".join(grid_card(i + 1, 0.5 * i) for i in range(5))
-    bars = bars if bars is not None else "".join(cbar_card(i + 1, i + 1, i + 2)
-                                                 for i in range(4))
-    path = tmp_path / name
-    path.write_text("SOL 103\nCEND\nBEGIN BULK\n" + grids + bars + extra + "ENDDATA\n")
-    return path
 
 
 def read_quietly(path):

@@ -19,10 +19,9 @@ import meshio
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from models import grid_solid, ss_reference, ssss_plate
 from numpy.testing import assert_allclose
 from scipy.spatial import cKDTree
-from test_shell9 import _ss_reference, ssss_plate
-from test_solid_verification import grid_solid
 
 import femmech as fm
 from femmech.fe.constraints import EquationSet, add_interpolated_nodes, constraint_transform
@@ -156,7 +155,7 @@ def test_free_quad8_plate_keeps_the_mitc9_frequencies():
     # 5.1e-2, 7.7e-2, 0.33 (a/t = 1e3: 6.3e-2 ... 0.47).
     t = 1e-2
     lam8 = ssss_plate(4, t, distort=0.3, kind="quad8", modes=4)
-    errors = lam8 / _ss_reference(t, 4) - 1
+    errors = lam8 / ss_reference(t, 4) - 1
     assert np.all(errors > 0)  # a conforming displacement model: from above
     assert errors[0] < 2e-3
     assert errors.max() < 2e-2

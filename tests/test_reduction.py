@@ -23,6 +23,7 @@ import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from models import assert_same_superelement
 from numpy.testing import assert_allclose, assert_array_equal, assert_array_less
 
 import femmech as fm
@@ -360,20 +361,6 @@ def test_error_estimates_rigid_modes_are_zero(free_grid):
 
 
 # --- 6. Save / load --------------------------------------------------------------------
-
-def assert_same_superelement(a, b):
-    for f in dataclasses.fields(Superelement):
-        if f.name in ("interior_factor", "inertia_response"):  # run-time caches, not saved
-            continue
-        x, y = getattr(a, f.name), getattr(b, f.name)
-        if sp.issparse(x):
-            assert x.shape == y.shape
-            assert (x != y).nnz == 0
-        elif isinstance(x, np.ndarray):
-            assert x.dtype == y.dtype, f.name
-            assert_array_equal(x, y)
-        else:
-            assert x == y, f.name
 
 
 def test_save_load_round_trip(tmp_path, frame):

@@ -184,7 +184,7 @@ def test_quadratic_shells_split_in_four_on_their_own_map(kind, cells):
     from pathlib import Path
 
     sys.path.insert(0, str(Path(__file__).parent))
-    from test_discretisation import plate_cells
+    from models import plate_cells
 
     # a 3 x 2 patch of elements on the (7 x 5)-node grid, bent onto a cylinder z = x²/4
     # (exactly quadratic: the parent's map reproduces it, so the children lie on it)

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 import sympy
+from models import CAM, PARAMS, simply_supported_beam
 from numpy.testing import assert_allclose
 from scipy.integrate import solve_ivp
-from test_coupling import CAM, PARAMS, _beam
 
 from femmech.analysis.response import (
     ConstantSpeed,
@@ -196,7 +196,7 @@ def _damped_cam_model():
 
 @pytest.fixture(scope="module")
 def cam_system():
-    fe = _beam()
+    fe = simply_supported_beam()
     se = craig_bampton(fe, "mid", n_modes=10)
     system = couple(se, [Mount(_damped_cam_model(), (Attachment("y_g", 20, "uy"),),
                                name="cam")])

@@ -7,7 +7,7 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from test_mesh_files_trust import deck
+from models import deck
 
 from femmech.scene.build import prepare
 from femmech.scene.load import Scene, load_scene

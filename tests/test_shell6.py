@@ -12,8 +12,8 @@ import meshio
 import numpy as np
 import pytest
 import scipy.linalg as sl
+from models import NU, RHO, STEEL, E, mindlin_ssss, ritz_kirchhoff, slope
 from numpy.testing import assert_allclose
-from test_shell_verification import NU, RHO, STEEL, E, mindlin_ssss, ritz_kirchhoff, slope
 
 import femmech as fm
 from femmech.fe.elements import shell6

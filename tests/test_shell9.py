@@ -12,8 +12,8 @@ from functools import partial
 import numpy as np
 import pytest
 import scipy.linalg as sl
+from models import NU, RHO, STEEL, E, ritz_kirchhoff, ss_reference, ssss_plate
 from numpy.testing import assert_allclose
-from test_shell_verification import mindlin_ssss, ritz_kirchhoff
 
 import femmech as fm
 from femmech.fe.dofs import element_dofs
@@ -22,9 +22,6 @@ from femmech.fe.elements.registry import ELEMENTS
 from femmech.fe.elements.shell9 import NODES, shell9_matrices
 from femmech.fe.generators import box, rectangular_plate
 from femmech.fe.mesh import quad8_to_quad9
-
-E, NU, RHO = 200e9, 0.3, 8000.0
-STEEL = fm.Material(E=E, nu=NU, rho=RHO)
 
 
 def _bilinear(corners, natural):
@@ -174,68 +171,12 @@ def test_bending_patch_test_constant_curvature():
     assert_allclose(u, exact, atol=1e-12)
 
 
-def ssss_plate(n, t, distort=0.0, kind="quad9", modes=4):
-    """Frequency parameters of the hard simply supported unit square plate, n x n mesh.
-
-    ``distort`` moves the interior element corners randomly by up to that fraction of
-    the element size (edge and centre nodes follow the straight-sided map).
-    """
-    mesh = rectangular_plate(1.0, 1.0, n, n, kind="quad9")
-    if distort:
-        mesh = _distorted(mesh, n, distort)
-    if kind == "quad8":
-        mesh = _to_quad8(mesh)
-    x, y = mesh.points[:, 0], mesh.points[:, 1]
-    edge_x = np.flatnonzero(np.isclose(x, 0) | np.isclose(x, 1))
-    edge_y = np.flatnonzero(np.isclose(y, 0) | np.isclose(y, 1))
-    supports = [fm.Support(np.arange(mesh.n_nodes), ["ux", "uy", "rz"]),
-                fm.Support(edge_x, ["uz", "rx"]), fm.Support(edge_y, ["uz", "ry"])]
-    model = fm.build_model(mesh, shells={"plate": fm.ShellProperty(t, STEEL)},
-                           supports=supports)
-    res = fm.modes(model, n_modes=modes)
-    D = E * t**3 / (12 * (1 - NU**2))
-    return (2 * np.pi * res.freq_hz * np.sqrt(RHO * t / D))[:modes]
-
-
-def _distorted(mesh, n, amount, seed=1):
-    """Move interior corner nodes; place edge and centre nodes on the straight-sided map."""
-    m = 2 * n + 1
-    P = mesh.points[:, :2].reshape(m, m, 2).copy()
-    rng = np.random.default_rng(seed)
-    shift = rng.uniform(-1, 1, (n - 1, n - 1, 2)) * amount / n
-    P[2:-1:2, 2:-1:2] += shift
-    P[1::2, ::2] = 0.5 * (P[:-1:2, ::2] + P[2::2, ::2])  # edge nodes between corners
-    P[::2, 1::2] = 0.5 * (P[::2, :-1:2] + P[::2, 2::2])
-    P[1::2, 1::2] = 0.25 * (P[:-1:2, :-1:2] + P[2::2, :-1:2] + P[:-1:2, 2::2] + P[2::2, 2::2])
-    points = np.column_stack([P.reshape(-1, 2), np.zeros(m * m)])
-    return fm.Mesh(points, mesh.cells, mesh.cell_sets, mesh.node_sets)
-
-
-def _to_quad8(mesh):
-    """The quad9 mesh without its centre nodes (quad8 cells, nodes renumbered)."""
-    cells = mesh.cells["quad9"]
-    keep = np.setdiff1d(np.arange(mesh.n_nodes), cells[:, 8])
-    new = np.full(mesh.n_nodes, -1)
-    new[keep] = np.arange(len(keep))
-    node_sets = {k: new[v][new[v] >= 0] for k, v in mesh.node_sets.items()}
-    return fm.Mesh(mesh.points[keep], {"quad8": new[cells[:, :8]]},
-                   {"plate": {"quad8": np.arange(len(cells))}}, node_sets)
-
-
-SS_REF = None
-
-
-def _ss_reference(t, modes=4):
-    pairs = [(1, 1), (1, 2), (2, 1), (2, 2), (1, 3), (3, 1), (2, 3), (3, 2), (1, 4), (4, 1)]
-    return np.array([mindlin_ssss(m, k, t) for m, k in pairs[:modes]])
-
-
 def _lambda1_errors(distort):
     """|λ₁/λ₁_exact - 1| on 4 x 4 MITC9 for a/t = 10, 100, 1e3, 1e4."""
     errors = []
     for slenderness in (10.0, 100.0, 1e3, 1e4):
         t = 1.0 / slenderness
-        errors.append(abs(ssss_plate(4, t, distort, modes=1)[0] / _ss_reference(t, 1)[0] - 1))
+        errors.append(abs(ssss_plate(4, t, distort, modes=1)[0] / ss_reference(t, 1)[0] - 1))
     return np.array(errors)
 
 
@@ -286,15 +227,15 @@ def test_thin_plate_first_ten_frequencies_within_0p1_percent_on_16x16():
     t = 1e-3
     lam = ssss_plate(16, t, modes=10)
     kirchhoff = np.sort([np.pi**2 * (m**2 + k**2) for m in range(1, 5) for k in range(1, 5)])
-    assert_allclose(_ss_reference(t, 10), kirchhoff[:10], rtol=4e-5)  # measured 3.1e-5
-    assert np.abs(lam / _ss_reference(t, 10) - 1).max() < 1e-3
+    assert_allclose(ss_reference(t, 10), kirchhoff[:10], rtol=4e-5)  # measured 3.1e-5
+    assert np.abs(lam / ss_reference(t, 10) - 1).max() < 1e-3
 
 
 def test_frequencies_converge_at_fourth_order():
     # thin plate a/t = 1000, n = 2, 4, 8, 16; measured slopes 3.9-4.3 for the first four
     # modes (λ of a p = 2 element: O(h^2p) = O(h⁴))
     t = 1e-3
-    ref = _ss_reference(t, 4)
+    ref = ss_reference(t, 4)
     ns = (2, 4, 8, 16)
     errors = np.array([np.abs(ssss_plate(n, t, modes=4) / ref - 1) for n in ns])
     assert np.all(errors > 0)  # stiff from above on these meshes

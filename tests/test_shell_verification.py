@@ -7,33 +7,11 @@ the comments (errors of MITC4 quads and MITC3 triangles fall as h², measured be
 
 import numpy as np
 import pytest
-import scipy.linalg as sl
-from numpy.polynomial import legendre, polynomial
+from models import NU, RHO, STEEL, E, mindlin_ssss, plate_mesh, ritz_kirchhoff, slope
 from numpy.testing import assert_allclose
 
 import femmech as fm
 from femmech.fe.sections import rectangle
-
-E, NU, RHO = 200e9, 0.3, 8000.0
-STEEL = fm.Material(E=E, nu=NU, rho=RHO)
-
-
-def plate_mesh(n, a=1.0, b=None, tri=False, ny=None):
-    """Rectangle [0, a] x [0, b] of n x ny quads (or 2 n ny triangles), group "plate"."""
-    b = a if b is None else b
-    ny = n if ny is None else ny
-    X, Y = np.meshgrid(np.linspace(0, a, n + 1), np.linspace(0, b, ny + 1))
-    points = np.column_stack([X.ravel(), Y.ravel(), np.zeros(X.size)])
-    i = np.arange(X.size).reshape(ny + 1, n + 1)
-    quads = np.column_stack([i[:-1, :-1].ravel(), i[:-1, 1:].ravel(), i[1:, 1:].ravel(),
-                             i[1:, :-1].ravel()])
-    if tri:  # alternate the diagonal so that the mesh has no preferred direction
-        flip = ((np.arange(ny)[:, None] + np.arange(n)) % 2).ravel().astype(bool)
-        t1 = np.where(flip[:, None], quads[:, [0, 1, 3]], quads[:, [0, 1, 2]])
-        t2 = np.where(flip[:, None], quads[:, [1, 2, 3]], quads[:, [0, 2, 3]])
-        cells = np.vstack([t1, t2])
-        return fm.Mesh(points, {"triangle": cells}, {"plate": {"triangle": np.arange(len(cells))}})
-    return fm.Mesh(points, {"quad": quads}, {"plate": {"quad": np.arange(len(quads))}})
 
 
 def frequency_parameters(mesh, t, supports, n_modes, material=STEEL, a=1.0):
@@ -55,61 +33,6 @@ def ssss(n, t, tri=False):
     supports = [fm.Support(np.arange(mesh.n_nodes), ["ux", "uy", "rz"]),
                 fm.Support(edge_x, ["uz", "rx"]), fm.Support(edge_y, ["uz", "ry"])]
     return frequency_parameters(mesh, t, supports, 4)
-
-
-def mindlin_ssss(m, n, t, a=1.0, k=5.0 / 6.0):
-    """Exact Mindlin frequency parameter of mode (m, n) of a simply supported square plate.
-
-    Mindlin, "Influence of rotatory inertia and shear on flexural motions of isotropic,
-    elastic plates", J. Appl. Mech. 18 (1951) 31-38: with ``w = W sin αx sin βy``,
-    ``ψx = X cos αx sin βy``, ``ψy = Y sin αx cos βy`` (α = mπ/a, β = nπ/a, k² = α² + β²)
-    the plate equations ``kGt (∇²w + ∇·ψ) = ρt ẅ`` and
-    ``D/2 [(1 - ν) ∇²ψ + (1 + ν) ∇(∇·ψ)] - kGt (ψ + ∇w) = ρt³/12 ψ̈`` become the 3 x 3
-    symmetric eigenproblem below; its lowest root is the flexural frequency.
-    """
-    G = E / (2 * (1 + NU))
-    D = E * t**3 / (12 * (1 - NU**2))
-    al, be = m * np.pi / a, n * np.pi / a
-    k2, s = al**2 + be**2, k * G * t
-    K = np.array([[s * k2, s * al, s * be],
-                  [s * al, D / 2 * ((1 - NU) * k2 + (1 + NU) * al**2) + s,
-                   D / 2 * (1 + NU) * al * be],
-                  [s * be, D / 2 * (1 + NU) * al * be,
-                   D / 2 * ((1 - NU) * k2 + (1 + NU) * be**2) + s]])
-    M = np.diag([RHO * t, RHO * t**3 / 12, RHO * t**3 / 12])
-    w2 = sl.eigh(K, M, eigvals_only=True)[0]
-    return np.sqrt(w2) * a**2 * np.sqrt(RHO * t / D)
-
-
-def ritz_kirchhoff(n, clamped, nu=NU):
-    """Kirchhoff square-plate frequency parameters by Rayleigh-Ritz (independent solver).
-
-    Basis ``φ_i(ξ) φ_j(η)`` on [-1, 1]², Legendre polynomials ``P_0..P_{n-1}`` (free
-    edges: natural conditions) or ``(1 - ξ²)² P_i`` (clamped); energy
-    ``D/2 ∫ w_xx² + w_yy² + 2ν w_xx w_yy + 2(1 - ν) w_xy²`` (Leissa 1969, eq. 1.5).
-    Upper bounds converging to 7 digits at n = 12 (checked against n = 16).
-    """
-    xq, wq = legendre.leggauss(2 * n + 12)
-    rows = []
-    for i in range(n):
-        c = legendre.leg2poly(np.eye(n)[i])
-        if clamped:
-            c = polynomial.polymul(c, [1, 0, -2, 0, 1])
-        rows.append([polynomial.polyval(xq, polynomial.polyder(c, d)) for d in range(3)])
-    F = np.array(rows)
-
-    def gram(p, q):
-        return np.einsum("iq,jq,q->ij", F[:, p], F[:, q], wq)
-
-    A0, A1, A2, B02 = gram(0, 0), gram(1, 1), gram(2, 2), gram(0, 2)
-    K = (np.kron(A2, A0) + np.kron(A0, A2) + nu * (np.kron(B02.T, B02) + np.kron(B02, B02.T))
-         + 2 * (1 - nu) * np.kron(A1, A1))
-    lam = sl.eigh(K, np.kron(A0, A0), eigvals_only=True)
-    return 4 * np.sqrt(np.abs(lam))  # d/dx = (2/a) d/dξ: λ = 4 sqrt(eigenvalue)
-
-
-def slope(h, err):
-    return np.polyfit(np.log(h), np.log(err), 1)[0]
 
 
 def test_mindlin_reference_tends_to_leissa_kirchhoff_values():

@@ -14,8 +14,8 @@ import math
 
 import numpy as np
 import pytest
+from models import mindlin_ssss, plate_mesh
 from numpy.testing import assert_allclose
-from test_shell_verification import mindlin_ssss, plate_mesh
 
 import femmech as fm
 from femmech.fe import sizing

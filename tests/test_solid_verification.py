@@ -8,61 +8,16 @@ the comments were measured with this code; the references are analytic
 tests/test_beam_verification.py; flat shells, tests/test_shell_verification.py).
 """
 
-import itertools
 
 import numpy as np
 import pytest
+from models import grid_solid
 from numpy.testing import assert_allclose
 
 import femmech as fm
-from femmech.fe.elements.solid import REFERENCE_NODES
 from femmech.fe.sections import rectangle
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
-_TET_EDGES = [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)]
-
-
-def _kuhn_tets():
-    """The six tetrahedra of the unit cube around its diagonal (Kuhn), positive volume."""
-    tets = []
-    for perm in itertools.permutations(range(3)):
-        v = [np.zeros(3)]
-        for axis in perm:
-            v.append(v[-1] + np.eye(3)[axis])
-        v = np.array(v)
-        if np.linalg.det(v[1:] - v[0]) < 0:
-            v[[1, 2]] = v[[2, 1]]
-        tets.append(v)
-    return tets
-
-
-def grid_solid(kind, xs, ys, zs, keep=None, group="solid"):
-    """Solid mesh of the boxes of the tensor grid ``xs x ys x zs`` (box boundaries, m).
-
-    ``keep`` (bool, one entry per box) selects boxes; a box is one hexahedron or six
-    tetrahedra. Quadratic nodes sit on the grid refined by midpoints.
-    """
-    xs, ys, zs = (np.asarray(c, dtype=float) for c in (xs, ys, zs))
-    shape = (len(xs) - 1, len(ys) - 1, len(zs) - 1)
-    keep = np.ones(shape, dtype=bool) if keep is None else np.asarray(keep)
-    if kind.startswith("hexahedron"):
-        local = [REFERENCE_NODES[kind]]
-    else:
-        local = _kuhn_tets()
-        if kind == "tetra10":
-            local = [np.vstack([t, [(t[a] + t[b]) / 2 for a, b in _TET_EDGES]]) for t in local]
-    fine = [np.sort(np.concatenate([c, (c[1:] + c[:-1]) / 2])) for c in (xs, ys, zs)]
-    dims = [len(f) for f in fine]
-    boxes = np.argwhere(keep)
-    cells = np.concatenate([
-        np.ravel_multi_index(np.moveaxis((2 * (boxes[:, None, :] + ref)).round().astype(int),
-                                         2, 0), dims) for ref in local])
-    used, cells = np.unique(cells, return_inverse=True)
-    cells = cells.reshape(-1, len(local[0]))
-    idx = np.unravel_index(used, dims)
-    points = np.column_stack([fine[a][idx[a]] for a in range(3)])
-    return fm.Mesh(points, {kind: cells}, {group: {kind: np.arange(len(cells))}})
-
 
 # --- cantilever bar, L = 1 m, square 0.05 m (L/h = 20) ---------------------------------
 L, H = 1.0, 0.05

@@ -33,7 +33,7 @@ from femmech.solve.pencil import eigenvalue_scale, factorize
 from femmech.solve.sturm import inertia_below
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_solid_verification import grid_solid  # noqa: E402
+from models import grid_solid  # noqa: E402
 
 STEEL = fm.Material(E=210e9, nu=0.3, rho=7850.0)
 RHS = sections.rectangular_hollow(0.06, 0.08, 0.004)
@@ -313,7 +313,6 @@ def test_solve_phase_limits_every_loaded_library():
     np.ones((4, 4)) @ np.ones((4, 4))  # make sure a BLAS is loaded
     with threads.limit(solve=1), threads.solve_phase():
         assert all(lib["num_threads"] == 1 for lib in threadpool_info())
-
 
 
 def test_gemm_phase_inside_a_solve_phase_and_back():

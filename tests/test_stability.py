@@ -17,31 +17,16 @@ import dataclasses
 import numpy as np
 import pytest
 import scipy.linalg as sla
-import sympy
+from models import hill_2dof
 from numpy.testing import assert_allclose
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 from scipy.special import mathieu_a, mathieu_b
 
-import femmech as fm
 from femmech.analysis.floquet import coupled_floquet, coupled_monodromy, floquet, monodromy
 from femmech.analysis.stability import StabilityChart, stability_chart
 from femmech.analysis.sweep import sweep
-from femmech.coupling import Attachment, Mount, couple, drive_breakpoints
-from femmech.fe import sections
-from femmech.mechanisms import (
-    CamProfile,
-    CamSegment,
-    Damper,
-    Mechanism,
-    PointMass,
-    RotaryInertia,
-    Spring,
-    polynomial_345,
-    position_function,
-    rheolinear,
-)
-from femmech.reduction.component_modes import craig_bampton
+from femmech.coupling import couple, drive_breakpoints
 
 # (kind, r, q, value, source)
 PUBLISHED = [
@@ -164,33 +149,11 @@ def test_damped_oscillator_multipliers():
     assert min(shift[0], 2 * np.pi / T - shift[0]) < 1e-10
 
 
-def _hill_2dof():
-    """Two coupled DOF with periodic mass, damping and stiffness (period 2π/3)."""
-    w = 3.0
-
-    def M(t):
-        m = np.zeros((t.size, 2, 2))
-        m[:, 0, 0] = 1.0 + 0.3 * np.cos(w * t)
-        m[:, 1, 1] = 2.0
-        m[:, 0, 1] = m[:, 1, 0] = 0.2 * np.sin(w * t)
-        return m
-
-    def C(t):
-        c = np.zeros((t.size, 2, 2))
-        c[:, 0, 0] = 20.0 + 8.0 * np.cos(w * t)
-        c[:, 1, 1] = 35.0
-        c[:, 0, 1], c[:, 1, 0] = -5.0, -5.0 + 2.0 * np.sin(2 * w * t)
-        return c
-
-    B = np.array([[0.2, 0.5], [-0.5, 0.1]])  # damping plus a gyroscopic part
-    return M, B, C, 2 * np.pi / w
-
-
 def test_magnus_converges_with_fourth_order():
     # Reference: the matrix ODE Φ' = A(t) Φ by DOP853 at rtol 1e-13 (independent
     # adaptive solver). Errors at 8..64 steps lie well above that; the fitted slope of
     # log(error) over log(h) is the order, 4 for two-point Gauss Magnus.
-    M, B, C, T = _hill_2dof()
+    M, B, C, T = hill_2dof()
 
     def rhs(t, y):
         tt = np.array([t])
@@ -258,41 +221,6 @@ def test_plot_stability_chart(tmp_path):
                                stable=chart.stable[2:], converged=chart.converged[2:])
     assert plot_stability_chart(line, tmp_path / "line.png").stat().st_size > 5000
     assert sorted(p.name for p in tmp_path.iterdir()) == ["chart.png", "line.png"]
-
-
-# Table 5.1 case 1 of the seed chapter, as in tests/test_coupling.py
-PARAMS = {"J1": 0.05, "m2": 3.0, "c1": 2e4, "c2": 5e5}
-CAM = CamProfile((CamSegment(np.pi / 2, 0.02, polynomial_345()), CamSegment(np.pi / 2, 0.0),
-                  CamSegment(np.pi / 2, -0.02, polynomial_345()), CamSegment(np.pi / 2, 0.0)))
-
-
-def _beam(n=40):
-    """Simply supported 1 m steel beam along x (uy bending carries the cam guide)."""
-    x = np.linspace(0.0, 1.0, n + 1)
-    mesh = fm.Mesh.from_lines(np.column_stack([x, 0 * x, 0 * x]),
-                              np.column_stack([np.arange(n), np.arange(1, n + 1)]),
-                              node_sets={"ends": [0, n], "mid": [n // 2]})
-    prop = fm.BeamProperty(sections.rectangular_hollow(0.06, 0.08, 0.004),
-                           fm.Material(E=210e9, nu=0.3, rho=7850.0))
-    return fm.build_model(mesh, {"all": prop}, supports=[
-        fm.Support("ends", "translations"), fm.Support(0, ["rx"])])
-
-
-@pytest.fixture(scope="module")
-def damped_cam_system():
-    """Table 5.1 case 1 cam on the simply supported beam (tests/test_coupling.py), with
-    dampers on the shaft twist and follower (2 N m s/rad, 80 N s/m) and Rayleigh
-    damping of the frame (B₀ += 1.0 M₀ + 1e-5 K₀)."""
-    theta, q1, yg, q2 = sympy.symbols("theta q1 y_g q2")
-    J1, m2, c1, c2, d1, d2 = sympy.symbols("J1 m2 c1 c2 d1 d2")
-    x2 = yg + position_function("U")(theta + q1) + q2
-    mech = Mechanism((q1, yg, q2, theta),
-                     (RotaryInertia(J1, theta + q1), PointMass(m2, (x2,)), Spring(c1, q1),
-                      Spring(c2, q2), Damper(d1, q1), Damper(d2, q2)), drives=(theta,))
-    model = rheolinear(mech, {**PARAMS, "d1": 2.0, "d2": 80.0}, {"U": CAM})
-    system = couple(craig_bampton(_beam(), "mid", n_modes=6),
-                    [Mount(model, (Attachment("y_g", 20, "uy"),), name="cam")])
-    return dataclasses.replace(system, B0=system.B0 + 1.0 * system.M0 + 1e-5 * system.K0)
 
 
 def test_coupled_monodromy_matches_direct_assembly(damped_cam_system):

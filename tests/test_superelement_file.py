@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_reduction import assert_same_superelement as assert_same
+from models import assert_same_superelement as assert_same
 
 from femmech.errors import FileFormatError
 from femmech.reduction.component_modes import guyan

@@ -15,7 +15,7 @@ import dataclasses
 import numpy as np
 import pytest
 import sympy
-from test_stability import CAM, PARAMS, _beam
+from models import CAM, PARAMS, simply_supported_beam
 
 from femmech.analysis.floquet import coupled_floquet, coupled_monodromy, floquet
 from femmech.analysis.response import rayleigh_damping
@@ -42,7 +42,7 @@ def undamped_frame():
                      (RotaryInertia(J1, theta + q1), PointMass(m2, (x2,)), Spring(c1, q1),
                       Spring(c2, q2), Damper(d1, q1), Damper(d2, q2)), drives=(theta,))
     model = rheolinear(mech, {**PARAMS, "d1": 2.0, "d2": 80.0}, {"U": CAM})
-    return couple(craig_bampton(_beam(), "mid", n_modes=6),
+    return couple(craig_bampton(simply_supported_beam(), "mid", n_modes=6),
                   [Mount(model, (Attachment("y_g", 20, "uy"),), name="cam")])
 
 
