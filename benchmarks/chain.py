@@ -23,7 +23,7 @@ side by side in one process, by
 Each time is the min and median of ``repeats`` runs after one warm-up run; errors are
 max |f - f_ref| / f_ref over the 10 frequencies. The growth exponent p of time ~ N^p is
 fitted (least squares in log-log) to each method's median times; the transfer method's
-is the acceptance check of issue 21 (O(N): p ≈ 1).
+is the acceptance check (O(N): p ≈ 1).
 
 Run: ``python benchmarks/chain.py [--sizes 10 30 100 300 1000 3000] [--repeats 3]``
 """

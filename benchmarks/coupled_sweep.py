@@ -36,7 +36,7 @@ def _example():
 
 def arpack_full(full, phi: float, n_modes: int) -> dict:
     """The full coupled problem at one angle by femmech (block Lanczos + Sturm check) and
-    by scipy's ``eigsh`` (ARPACK, the reference named in issue 10), side by side.
+    by scipy's ``eigsh`` (ARPACK, the named reference), side by side.
 
     ARPACK runs in shift-invert mode at the shift femmech's solve settled on (after its
     far-shift correction; ARPACK at the default shift of the textile shaft took 24-35 s

@@ -5,9 +5,9 @@ steel box members, base joints clamped): ``tiny`` 1 080, ``20k`` 23 760 and ``15
 151 200 free DOFs. Interfaces (all six DOFs of each node):
 
 - ``8 joints``: 8 top joints, the corners and the middles of the edges of the top face
-  (n_b = 48, the ≤ 50 interface DOFs of issue 10);
+  (n_b = 48, the ≤ 50 interface DOFs of the target);
 - ``rails``: the first 167 nodes of the top face in (y, x) order, i.e. whole lines of
-  top members (n_b = 1 002, the ~1000 interface DOFs of issue 10; all 45 top-face nodes,
+  top members (n_b = 1 002, the ~1000 interface DOFs of the target; all 45 top-face nodes,
   n_b = 270, on the tiny frame).
 
 For each model: one full 20-mode eigensolve (``femmech.modes``, default solver), then
@@ -47,7 +47,7 @@ from solvers import MODELS  # noqa: E402
 from solvers import build as build_model  # noqa: E402
 
 N_FULL = 20  # modes of the full reference solve
-N_MODES = 30  # fixed-interface modes (issue 10: 20-40)
+N_MODES = 30  # fixed-interface modes (target range: 20-40)
 RAIL_NODES = 167  # 6 x 167 = 1 002 interface DOFs
 FRAMES = tuple(name for name, (kind, _) in MODELS.items() if kind == "frame")
 INTERFACES = ("8 joints", "rails")
@@ -151,7 +151,7 @@ def format_tables(rows) -> list[str]:
                   ["case", "free DOFs", "interface", "n_b", "variant", "n_q", "n_res",
                    "factor s", "constr s", "fixed-if s", "project s", "reduce s",
                    "full eig s", "ratio", "err f1-10", "err f1-20"], lines) + [
-        "ratio = reduce s / full eig s (issue 10 targets: <= 1.3 for n_b <= 50, <= 2.5 for"
+        "ratio = reduce s / full eig s (targets: <= 1.3 for n_b <= 50, <= 2.5 for"
         " n_b ~ 1000); fixed-if includes the residual vectors (CB+RV);",
         f"err = largest relative error of the reduced f1..f10 / f1..f{N_FULL} against the"
         f" full model's (femmech.modes, solver {rows[0]['solver'] if rows else '-'}).", ""]

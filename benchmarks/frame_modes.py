@@ -280,7 +280,7 @@ def reference_frequencies(model, sigma, solver):
 def counted_eigsh(K, M, k: int, sigma: float, factor, return_eigenvectors: bool = True):
     """scipy's ``eigsh`` (ARPACK), shift-invert at ``sigma`` (rad²/s²) with ``factor`` (a
     factorisation of ``K - σM`` with ``solve``) as ``OPinv``, tol = 0, a start vector of
-    ones and one thread in its loop: the issue-10 reference algorithm on a given factor.
+    ones and one thread in its loop: the reference algorithm on a given factor.
 
     Returns the ``k`` eigenvalues ω² (rad²/s², ascending) and the number of solves ARPACK
     made. ``return_eigenvectors`` is passed to ``eigsh``.

@@ -1,4 +1,4 @@
-"""Scene fuzzing (issue 19): mutated example scenes through ``femmech check`` and ``run``.
+"""Scene fuzzing: mutated example scenes through ``femmech check`` and ``run``.
 
 Every shipped scene ``examples/*.toml`` is mutated, schema-level (nearby values, values of
 the right and wrong types, boundary numbers, huge counts, deleted, misspelt and extra keys,

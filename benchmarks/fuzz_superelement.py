@@ -1,4 +1,4 @@
-"""Superelement-file fuzzing (issue 19): mutated ``.npz`` files through ``Superelement.load``.
+"""Superelement-file fuzzing: mutated ``.npz`` files through ``Superelement.load``.
 
 A small real superelement (a 1 x 1 x 1-bay steel grid frame with a rigid link, so T has
 non-unit rows; Craig-Bampton with residual vectors: 24 interface DOFs, 30 modal

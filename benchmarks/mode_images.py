@@ -1,16 +1,16 @@
 """Benchmark: time per mode image, the old path (one plotter per image) and the new one.
 
-Issue 20, item 8. The frame example (``examples/frame_modes.py``: 193 beam elements,
+The frame example (``examples/frame_modes.py``: 193 beam elements,
 springs, a motor mass on a rigid link; 12 modes) and the shell example
 (``examples/shell_frame_modes.py``: 1 576 nodes of shells, stiffeners, a spider; 8
 images, as the example writes) are drawn at the default 1024 x 768 by
 
-- ``old``: the per-image path of femmech before issue 20 (a verbatim copy below, from
+- ``old``: the former per-image path of femmech (a verbatim copy below, from
   ``femmech/output/plot.py`` at commit 21c9fe6): a new off-screen plotter per image,
   2 x 2 supersampling with VTK's default 4-sample MSAA and five-light kit, the camera
   reset per image, ``plot_mode`` called in a loop (as ``plot_modes`` did);
 - ``new``: :func:`femmech.output.plot_modes` with ``workers=1``: one scene per model,
-  points and scalars replaced per mode, one camera, the annotations of issue 20 item 2;
+  points and scalars replaced per mode, one camera, the current annotations;
 - ``new, 2 workers``: the same on two spawned worker processes.
 
 Each path runs ``--repeats`` times (default 3) into a fresh folder; the table gives the

@@ -1,4 +1,4 @@
-"""Issue 24, target 2: Craig-Bampton reduction against one full 20-mode eigensolve.
+"""Peer target 2: Craig-Bampton reduction against one full 20-mode eigensolve.
 
 femmech: ``craig_bampton(model, 8 top joints (n_b = 48), n_modes=30)`` with residual
 vectors (the default), i.e. one factorisation of K_ii serving the constraint modes, the

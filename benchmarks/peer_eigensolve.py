@@ -1,4 +1,4 @@
-"""Issue 24, target 1: the full 20-mode eigensolve against scipy's ``eigsh``.
+"""Peer target 1: the full 20-mode eigensolve against scipy's ``eigsh``.
 
 femmech: ``fm.modes(model, 20)`` with its defaults (backend ``auto``, block Lanczos, Sturm
 completeness check, residual check, mass normalisation). Peer: what a user would write

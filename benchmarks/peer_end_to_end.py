@@ -1,4 +1,4 @@
-"""Issue 24, target 6 (first half): a 360-angle coupled study against 360 full ARPACK solves.
+"""Peer target 6 (first half): a 360-angle coupled study against 360 full ARPACK solves.
 
 The machine: examples/textile_shaft.py with 12 cams (main shaft, pedestals and base beam
 as one beam FE model; per cam a follower on a contact spring, attached to the shaft's rx

@@ -1,4 +1,4 @@
-"""Issue 24, target 7: femmech's Craig-Bampton against Exudyn's Hurty-Craig-Bampton.
+"""Peer target 7: femmech's Craig-Bampton against Exudyn's Hurty-Craig-Bampton.
 
 The same reduction on both sides (benchmarks/exudyn_hcb.py explains how the two are made
 equal): the grid frames' ``K_free``, ``M_free``, all six DOFs of 8 top joints (n_b = 48),

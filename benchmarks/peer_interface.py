@@ -1,9 +1,9 @@
-"""Issue 24 target 3: Craig-Bampton with a reduced interface for rails (~1 000 interface DOFs).
+"""Peer target 3: Craig-Bampton with a reduced interface for rails (~1 000 interface DOFs).
 
 Target: the reduction (``femmech.reduction.reduce_interface``) costs <= 3x one full
 20-mode eigensolve (``femmech.modes(model, 20)``) of the same model, and the coupled
 quasi-eigenfrequencies in the band stay within 0.1 % of the unreduced-interface model
-(plain Craig-Bampton with residual vectors, ``craig_bampton``, the issue's 4.7-14x).
+(plain Craig-Bampton with residual vectors, ``craig_bampton``, the target's 4.7-14x).
 
 Models: the grid frames of benchmarks/peers.py (``frame``): ``tiny`` 1k (1 080 free DOFs;
 rails = all 45 top nodes, n_b = 270), ``small`` 24k (23 760; n_b = 1 002) and ``medium``

@@ -1,4 +1,4 @@
-"""Issue 24, target 6 (second half): peak memory of reducing a ~1M-DOF shell frame.
+"""Peer target 6 (second half): peak memory of reducing a ~1M-DOF shell frame.
 
 A closed steel box of 6 mm MITC4 shells (4.0 x 0.8 x 0.6 m, ``box(..., nx, ny, nz)``,
 clamped at x = 0), reduced by ``craig_bampton`` onto all six DOFs of four top-plate nodes

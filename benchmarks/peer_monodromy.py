@@ -1,4 +1,4 @@
-"""Issue 24, target 5: a stability-chart point against ``solve_ivp`` (DOP853).
+"""Peer target 5: a stability-chart point against ``solve_ivp`` (DOP853).
 
 femmech: the monodromy matrix over one period with its error control, as a stability chart
 computes each point (``coupled_monodromy_record`` / ``monodromy_record`` at the default

@@ -1,10 +1,10 @@
-"""Issue 24, target 4: the reduced coupled sweep per angle against bare LAPACK solves.
+"""Peer target 4: the reduced coupled sweep per angle against bare LAPACK solves.
 
 femmech: ``sweep(system, phi, n_modes, keep_vectors=True)`` over 360 angles, tracked (MAC
 assignment with cluster subspaces), vectors kept: the lean batched path of
 :mod:`femmech.analysis.sweep`. Its time includes evaluating the mechanisms at all angles.
 Before: the general per-angle path of the same module (``_sweep_loop``, the path every sweep
-took before issue 24), same results. Peer: ``scipy.linalg.eigh(C, M)`` of the same pencils
+once took), same results. Peer: ``scipy.linalg.eigh(C, M)`` of the same pencils
 (the sweep's C(φ) and M(φ), assembled beforehand and not timed), one call per angle, under
 the same thread limits, ``check_finite=False``, with the drivers that return all pairs
 (``gv``, ``gvd``) or the ``n_modes`` lowest (``gvx``); the fastest driver is the peer.
@@ -108,7 +108,7 @@ def lapack_floor(M, C, q: int):
 
 
 def general_path(system, phi, n_modes: int):
-    """The per-angle path (before issue 24) with the lean path's arguments."""
+    """The general per-angle path with the lean path's arguments."""
     extra = min(n_modes + max(2, n_modes // 2), system.n - 1)
     with threads.solve_phase():
         matrices = sweep_module._angle_matrices(system, phi, 0.0, 0.0, False)
@@ -158,7 +158,7 @@ def main(size: str = "small", repeats: int = 3):
           peers.verdict(x["ratio_gvd"], TARGET), str(x["q"]), x["t"]["floor"].cell(ms),
           f"{x['t']['floor'].min / x['t'][x['peer']].min:.2f}"] for x in rows])
     text += ["peer: the fastest bare driver (gvx computes only the n_modes lowest pairs);"
-             " sygvd (gvd, all pairs) is the solve the issue names as the per-angle reference",
+             " sygvd (gvd, all pairs) is the named per-angle reference",
              "q: candidates the sweep solves for per angle (the n_modes-th branch's cluster"
              " whole); LAPACK floor: the sweep's LAPACK calls for them alone (sygvd, or"
              " sygvx below 1/7 of the pairs), inputs formed beforehand."]

@@ -1,4 +1,4 @@
-"""Shared pieces of the peer comparisons of issue 24 (benchmarks/run.py, ``--suite peers``).
+"""Shared pieces of the peer comparisons (benchmarks/run.py, ``--suite peers``).
 
 Every target table compares femmech with the tool a user would run instead, on the same
 matrices, in the same process, with the minimum and the median of ``repeats`` runs of each

@@ -1,6 +1,6 @@
 """Check that two revisions of femmech compute the same results, to the bit.
 
-A change that only moves code (issue 23: the package restructure) must not change a
+A change that only moves code (a package restructure) must not change a
 single number. This script runs every example scene (``examples/*.toml``, through the
 CLI) and every example script (``examples/*.py --out``) once with the working tree and
 once with a git revision (checked out into a temporary worktree, imported through

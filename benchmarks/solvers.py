@@ -16,8 +16,8 @@ much denser) and each backend of
   ``eigsh`` (k = 20, default ncv = 41, tol = 0) in shift-invert mode at the same σ with
   this backend's factor as ``OPinv`` (one thread during its loop), no Sturm check; its
   time with the factorisation and the number of solves it made;
-- *ratio*: eigen time / the unit time of the fastest backend on that model (issue 10
-  target: <= 1.3), the same without the Sturm check, and ARPACK's time over that unit;
+- *ratio*: eigen time / the unit time of the fastest backend on that model
+  (target: <= 1.3), the same without the Sturm check, and ARPACK's time over that unit;
 - *agreement*: the largest relative difference of the frequencies from the first
   backend's (SuperLU).
 

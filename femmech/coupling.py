@@ -28,7 +28,7 @@ textile shaft (examples/textile_shaft.py, 4 cams, f_max 400 Hz) gave quasi-frequ
 6.6e-5 off, against 6e-13 at the interface node. Output at interior nodes (recovery
 through Ψ and Φ, :func:`frame_row`) is the reduced model's own and stays allowed.
 
-Stage 4 (coupling): uses reduction, fe and mechanisms (the position protocol); no analysis.
+Uses reduction, fe and mechanisms (the position protocol); no analysis.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Stage 0, names resolved on first use: public names that moved keep working, with a
+"""Names resolved on first use: public names that moved keep working, with a
 DeprecationWarning, and a package's public names load their modules when first used.
 
 An old place is either a module that lost names (it ends with a module-level

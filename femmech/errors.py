@@ -9,7 +9,7 @@ documented exit codes (:mod:`femmech.cli`).
 :func:`did_you_mean` and :func:`name_list` word the messages for a name that does not
 exist (a group of a mesh, a key), so that every stage lists the available names the same way.
 
-Stage 0: imports nothing of femmech; every module may import it.
+Imports nothing of femmech; every module may import it.
 """
 
 import difflib

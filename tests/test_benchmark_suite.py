@@ -171,5 +171,5 @@ def test_old_suite_names_still_run_with_a_deprecation_message(suite, monkeypatch
                        "--out", str(tmp_path)])
     assert code == 0
     assert "--suite issue10 is deprecated; use --suite components" in capsys.readouterr().err
-    with pytest.raises(ValueError, match="unknown suite 'issue99'"):
-        suite.main("tiny", out_dir=None, echo=False, suite="issue99")
+    with pytest.raises(ValueError, match="unknown suite 'nonexistent'"):
+        suite.main("tiny", out_dir=None, echo=False, suite="nonexistent")

@@ -20,6 +20,6 @@ One job per module:
   drive-force limit, braking (a crane's load-moment limiter, a press's overload clutch).
 * :mod:`.studies`: design studies as independent jobs on an executor (processes, Dask).
 
-Stage 5 (analysis): uses coupling, reduction, fe, mechanisms, solve and errors; nothing
+Uses coupling, reduction, fe, mechanisms, solve and errors; nothing
 here writes files (that is :mod:`femmech.output`).
 """

@@ -22,7 +22,7 @@ refinement changed the frequency by more than ``max_change``; then h is too coar
 the extrapolation, and the error is at least the change), ``"rate"`` (with ``levels=3``:
 the observed rate is below 0.7 p, so the estimate may be optimistic), ``"rigid"``.
 
-Stage 5 (analysis): uses analysis.modes, fe (mesh, model, refine) and errors.
+Uses analysis.modes, fe (mesh, model, refine) and errors.
 """
 
 from __future__ import annotations

@@ -33,7 +33,7 @@ against a second run at ten times tighter tolerances (:class:`Accuracy`).
 Units SI: m, rad, s, N, N·m; drive forces in N for a translational drive, N·m for a
 rotational one.
 
-Stage 5 (analysis): uses mechanisms (the 2nd-kind model and its springs) and
+Uses mechanisms (the 2nd-kind model and its springs) and
 analysis.response (the drive law); nothing here writes files.
 """
 

@@ -20,7 +20,7 @@ as functions of time (:func:`monodromy`) or for a coupled machine at constant dr
 :func:`quasi_modal_basis`), and the multipliers and exponents from it (:func:`floquet`,
 :class:`Floquet`). Charts over speed are :mod:`femmech.analysis.stability`.
 
-Stage 5 (analysis): uses coupling, errors and analysis.magnus and .sweep; nothing here
+Uses coupling, errors and analysis.magnus and .sweep; nothing here
 writes files.
 """
 

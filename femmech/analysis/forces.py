@@ -21,7 +21,7 @@ direction of the coordinate it belongs to.
   axes, with the beam convention stated in :class:`SectionForces` (not the coordinate
   convention above).
 
-Stage 5 (analysis): uses analysis.response, coupling, reduction and fe; nothing here writes
+Uses analysis.response, coupling, reduction and fe; nothing here writes
 files.
 """
 

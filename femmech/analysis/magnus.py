@@ -26,17 +26,15 @@ Why this scheme rather than explicit RK4 or an adaptive solver:
   at once (:func:`expm_stack`, batched scaling and squaring) and multiplied in a
   balanced tree, so the per-step Python cost is nil.
 
-Cost per step (the press example, 2n = 50, measured 2.8 to 3.2 times faster
-than before, same step counts): the step exponents are formed in *balanced* coordinates
-D⁻¹ A D (:func:`_balancing`, powers of 2, exact): ‖hA‖₁ of a stiff frame is ~ω_max² h
-against eigenvalues ~ω_max h, 1e6 against 18 on the press, and the balancing cuts the
-squarings of the exponential from ~18 to ~5 (and the round-off they amplify: the press's
-spectral radius at 16 384 steps went from 1e-9 to 4e-13 off the reference). The
+Cost per step: the step exponents are formed in *balanced* coordinates D⁻¹ A D
+(:func:`_balancing`, powers of 2, exact): ‖hA‖₁ of a stiff frame is ~ω_max² h against
+eigenvalues ~ω_max h, and the balancing cuts the squarings of the exponential, and the
+round-off they amplify, to the few that the eigenvalues need. The
 exponentials use the degree-18 Taylor polynomial in five products (:func:`expm_stack`),
 without the linear solve of a Padé approximant; the commutator uses the block structure
 of A (four n-wide products, :func:`_first_order_commutator`); M⁻¹ is formed once per
 node; and exponentials and products run in batches of ~1 MiB (:data:`_CACHE_BYTES`) that
-stay in the processor's cache, which halved the time per step against 32 MiB batches.
+stay in the processor's cache.
 Tried and dropped (benchmarks/peer_monodromy.py, docs): the sixth-order Magnus method
 with three Gauss points needs *more* steps on the press (its commutator terms grow as
 (ω_max h)³ where ω_max h ~ 10 to 30, so its pre-asymptotic results are NaN or wrong up
@@ -55,7 +53,7 @@ quadrature straddles a jump of the coefficients.
 
 Global error O(h⁴) (tests/test_stability.py measures the order).
 
-Stage 5 (analysis): of femmech uses only analysis.response (the step-control check);
+Of femmech uses only analysis.response (the step-control check);
 nothing here knows machines or writes files.
 """
 
@@ -77,8 +75,8 @@ a chunk at a time."""
 
 _CACHE_BYTES = 2**20
 """Memory per stacked array of one batch of step exponentials (1 MiB, 64 steps of a 50-wide
-system): the exponentials and products of a batch stay in the processor's cache, twice
-as fast per step as whole chunks."""
+system): the exponentials and products of a batch stay in the processor's cache, which
+whole chunks do not."""
 
 RTOL = 1e-4
 """Default tolerance on the spectral radius of a monodromy matrix (relative). The

@@ -38,7 +38,7 @@ The label (rule of :func:`classify_mode`, thresholds as module constants):
 Only beam models are classified: shell and solid strain energy cannot be told apart from
 springs here, so models with shells or solids raise ValueError.
 
-Stage 5 (analysis): uses fe only (model, DOF numbering, beam element matrices).
+Uses fe only (model, DOF numbering, beam element matrices).
 """
 
 from __future__ import annotations

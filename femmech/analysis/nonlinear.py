@@ -37,7 +37,7 @@ sec. VII.2; Baumgarte, Comput. Meth. Appl. Mech. Eng. 1 (1972) 1):
 Units SI (m, rad, s, N, N·m); symbols of the chapter: M mass, Q* generalized forces,
 H = (h_ij) constraint Jacobian, λ multipliers.
 
-Stage 5 (analysis): uses only mechanisms (the models it integrates); nothing here writes
+Uses only mechanisms (the models it integrates); nothing here writes
 files.
 """
 

@@ -22,7 +22,7 @@ rigid-body vectors, not from element formulas, so point masses and every element
 count. :func:`element_group_masses` gives the share of each element group (density
 times length·area, area·thickness or volume) for a cross-check against M.
 
-Stage 5 (analysis): uses fe (checks.cell_measure, dofs, model) and solve (factorize, the
+Uses fe (checks.cell_measure, dofs, model) and solve (factorize, the
 rigid-body vectors of :func:`femmech.solve.lobpcg.rigid_body_modes`);
 pure functions on arrays, plus :func:`participation` for an FEModel and a ModeSet.
 """

@@ -25,7 +25,7 @@ dissipation is set by the spectral radius ρ∞ at h → ∞: the stiff frame mo
 the excitation are damped (ρ∞ < 1) without touching the resolved low modes, while
 ρ∞ = 1 is the trapezoidal rule (Newmark average acceleration, energy conserving).
 
-Stage 5 (analysis): uses coupling, fe (node and DOF lookup) and errors; nothing here writes
+Uses coupling, fe (node and DOF lookup) and errors; nothing here writes
 files.
 """
 
@@ -351,7 +351,7 @@ def periodic_steady_state(system, Omega: float, n_steps: int = 512, rho_inf: flo
         O(h⁴); the combination still satisfies the equation of motion at the grid points
         (weights summing to 1, linear equations). Worth it near resonances, where the
         O(h²) frequency error of the integrator shifts the resonance peak
-        (benchmarks/response.py: 1.4 % at 512 steps, 3e-4 extrapolated). For ρ∞ < 1
+        (benchmarks/response.py). For ρ∞ < 1
         the gain is one order only.
     rtol : float or None
         Tolerance of the step-doubling check; ``None``: integrate with ``n_steps`` only

@@ -29,7 +29,7 @@ every registered shell element kind.
 energy in the nominal inertia) are reported; the measured gap between the two populations
 (below 0.07 and above 0.99) leaves the threshold uncritical.
 
-Stage 5 (analysis): uses fe (the model, its checks and DOF numbering).
+Uses fe (the model, its checks and DOF numbering).
 """
 
 from __future__ import annotations

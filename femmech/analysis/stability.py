@@ -7,7 +7,7 @@ step-doubling record (:mod:`femmech.analysis.magnus`); unconverged points are ma
 :func:`speed_study` adds Rayleigh frame damping, a quasi-modal Ritz basis and the
 predicted resonance speeds 2 f_k / j (:func:`resonance_speeds`) in one call.
 
-Stage 5 (analysis): uses coupling, errors and analysis.floquet, .magnus, .response and
+Uses coupling, errors and analysis.floquet, .magnus, .response and
 .sweep; nothing here writes files.
 """
 

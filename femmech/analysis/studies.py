@@ -20,7 +20,7 @@ objects of module-level classes, not lambdas or closures. Models holding symboli
 mechanisms (sympy functions created at run time) do not pickle: send a *recipe* (a
 module-level function and its parameters) that builds the model inside the job.
 
-Stage 5 (analysis): uses analysis.stability and .sweep, solve (thread limits) and errors;
+Uses analysis.stability and .sweep, solve (thread limits) and errors;
 nothing here writes files.
 """
 

@@ -1,4 +1,4 @@
-"""Stage 2, the finite-element model: meshes, sections, materials, elements, assembly.
+"""The finite-element model: meshes, sections, materials, elements, assembly.
 
 Data flow: mesh (:mod:`.mesh`, :mod:`.generators`; files through :mod:`.mesh_io`, with
 their sets by :mod:`.mesh_sets`, :mod:`.abaqus_sets`, :mod:`.nastran_sets`, the lines meshio

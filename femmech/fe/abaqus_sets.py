@@ -22,7 +22,7 @@ generation (``*NGEN``, ``*NFILL``, ``*NCOPY``, ``*NMAP``, ``*ELGEN``, ``*ELCOPY`
 node coordinate systems (``*SYSTEM``, ``*NODE, SYSTEM=``), several instances and moved
 instances.
 
-Stage 2 (fe, independent of mechanisms): imports only femmech.errors, fe.mesh and
+Imports only femmech.errors, fe.mesh and
 fe.mesh_sets (limits).
 """
 

@@ -33,7 +33,7 @@ Element shapes (:func:`shell_shapes`, :func:`shape_findings`)
     :mod:`femmech.fe.elements.shell`) and group. Spurious drilling modes of thick shells
     are a property of the modes, not the inputs: :mod:`femmech.analysis.shell_checks`.
 
-Stage 2 (fe, independent of mechanisms): uses only errors (ModelWarning).
+Uses only errors (ModelWarning).
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ master is the slave of another) are resolved by substitution. Fixed and dependen
 are removed; the reduced matrices are ``Tᵀ K T`` and ``Tᵀ M T``, with no penalty
 stiffness to spoil the conditioning.
 
-Stage 2 (fe, independent of mechanisms): uses only fe.dofs.
+Uses only fe.dofs.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 Components are ordered ``ux, uy, uz, rx, ry, rz`` (m and rad).
 
-Stage 2 (fe, independent of mechanisms): imports nothing of femmech.
+Imports nothing of femmech.
 """
 
 from __future__ import annotations

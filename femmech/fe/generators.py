@@ -1,6 +1,6 @@
 """Parametric meshes of machine-like frames, for examples, tests and benchmarks.
 
-Stage 2 (fe, independent of mechanisms): uses only fe.mesh.
+Uses only fe.mesh.
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 A node is referred to by its index or by the name of a group that holds exactly one
 node. All matrices act in global axes unless a spring is given its own ``axes``.
 
-Stage 2 (fe, independent of mechanisms): uses only fe.materials.
+Uses only fe.materials.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The mesh: points, cells by type, named cell sets and node sets (meshio conventions).
 
-Stage 2 (fe, independent of mechanisms): imports only femmech.errors (message wording) and
+Imports only femmech.errors (message wording) and
 femmech.html (notebook view).
 """
 

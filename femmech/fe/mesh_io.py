@@ -11,7 +11,7 @@ What a file holds that the model will not have is said, not dropped silently: on
 :class:`~femmech.errors.ModelWarning` per file names elements repeated on the same nodes
 and, for Nastran, the cards femmech does not carry (:mod:`femmech.fe.nastran_cards`).
 
-Stage 2 (fe, independent of mechanisms): uses fe.mesh, fe.mesh_sets, fe.abaqus_sets,
+Uses fe.mesh, fe.mesh_sets, fe.abaqus_sets,
 fe.nastran_sets, fe.nastran_cards (and meshio).
 """
 

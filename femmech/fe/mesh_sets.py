@@ -27,7 +27,7 @@ end up with one name keep it apart by a suffix ``~2``, ``~3`` with a
 checked against its block (ranges, integer type) and a bad set raises
 :class:`~femmech.errors.FileFormatError` naming the set.
 
-Stage 2 (fe, independent of mechanisms): imports only femmech.errors (and numpy).
+Imports only femmech.errors (and numpy).
 """
 
 from __future__ import annotations

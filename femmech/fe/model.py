@@ -4,7 +4,7 @@ Symbols: K stiffness (N/m, N m/rad), M mass (kg, kg m²), both (n_dof, n_dof) CS
 ``n_dof = 6 n_nodes``; constraints are eliminated by ``u = T u_free`` so that the free
 system is ``Tᵀ K T``, ``Tᵀ M T``.
 
-Stage 2 (fe, independent of mechanisms): uses only the fe package (mesh, sections,
+Uses only the fe package (mesh, sections,
 materials, elements, assembly, constraints, lumped items, parts, checks).
 """
 

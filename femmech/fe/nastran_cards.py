@@ -19,7 +19,7 @@ the bulk data once, before meshio does, and
 :func:`not_carried` words the counts as one line for a
 :class:`~femmech.errors.ModelWarning`.
 
-Stage 2 (fe, independent of mechanisms): imports only femmech.errors and
+Imports only femmech.errors and
 fe.nastran_sets (the card reader).
 """
 

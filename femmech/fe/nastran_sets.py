@@ -18,7 +18,7 @@ with continuation lines are read. A GRID in a local coordinate system (``CP`` â‰
 refused, since meshio would place it wrongly. Every problem is a
 :class:`~femmech.errors.FileFormatError` naming the card and its line.
 
-Stage 2 (fe, independent of mechanisms): imports only femmech.errors and fe.mesh_sets
+Imports only femmech.errors and fe.mesh_sets
 (limits).
 """
 

@@ -10,7 +10,7 @@ tie the beam node to a patch of solid nodes with a
 that only solid elements touch carry neither stiffness nor mass; ``build_model`` removes
 them (:attr:`femmech.fe.model.FEModel.inactive`).
 
-Stage 2 (fe, independent of mechanisms): uses fe.mesh, .materials, .dofs and the element
+Uses fe.mesh, .materials, .dofs and the element
 registry (:mod:`femmech.fe.elements.registry`): every registered shell and solid cell
 kind is assembled here.
 """

@@ -4,7 +4,7 @@ Recovery turns nodal DOF vectors (a static solution or a mode shape) into fields
 the elements, so that coarse meshes draw as smooth curves and exported fields can be
 sampled between nodes. Everything is vectorised over elements.
 
-Stage 2 (fe, independent of mechanisms): uses fe.model, .dofs and the beam element.
+Uses fe.model, .dofs and the beam element.
 """
 
 from __future__ import annotations

@@ -30,7 +30,7 @@ curved cells stay on their surface. ``line3``, ``quad8``, ``tetra10``, ``hexahed
 ``hexahedron27`` and wedges are not refined: :func:`refine_mesh` raises
 NotImplementedError naming the kind.
 
-Stage 2 (fe): uses fe.mesh and fe.model (:func:`refined_model` rebuilds with
+Uses fe.mesh and fe.model (:func:`refined_model` rebuilds with
 :func:`~femmech.fe.model.build_model`).
 """
 

@@ -29,7 +29,7 @@ limit): MITC4 0.056 (diagonal waves) to 0.118 (waves 9.5° off a grid line, risi
 towards aligned waves; bound 0.125), MITC3 0.091 to 0.112 (bound 0.115); rate 2.0 for
 both. Thicker plates (t/a = 0.05, 0.1) give smaller constants.
 
-Stage 2 (fe, independent of mechanisms): uses fe.sections and fe.materials (beam
+Uses fe.sections and fe.materials (beam
 properties are read by attribute); no assembly, no eigen solves.
 """
 

@@ -18,7 +18,7 @@ C stiffness, F force.
 * :mod:`.catalogue`: what the built-in models' coordinates and parameters mean (units,
   signs; the readable labels of tables and plots, docs/mechanisms.md).
 
-Stage 2 (mechanisms, independent of fe): imports only its own modules.
+Imports only its own modules.
 """
 
 from femmech.mechanisms.chapter import (

@@ -20,7 +20,7 @@ drive. Examples
 Coordinate meanings, units and signs: :data:`femmech.mechanisms.catalogue.CATALOGUE`
 (docs/mechanisms.md, "Reference of the built-in mechanisms").
 
-Stage 2 (mechanisms, independent of fe): uses mechanisms.symbolic, .motion_laws and
+Uses mechanisms.symbolic, .motion_laws and
 .catalogue.
 """
 

@@ -9,7 +9,7 @@ argument, and its values U, U', U'', U''' are passed in. So cams, linkages and t
 functions plug into the same compiled equations, and the (slow) symbolic step is done
 once per mechanism and cached.
 
-Stage 2 (mechanisms, independent of fe): uses mechanisms.symbolic and .position.
+Uses mechanisms.symbolic and .position.
 """
 
 import functools

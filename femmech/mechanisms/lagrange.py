@@ -17,7 +17,7 @@ place of Σ c_jk q_k) read
 
 Symbols follow the textbook: M mass, B damping, C stiffness, F force.
 
-Stage 2 (mechanisms, independent of fe): uses only mechanisms.symbolic.
+Uses only mechanisms.symbolic.
 """
 
 import functools

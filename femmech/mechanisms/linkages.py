@@ -12,7 +12,7 @@ References
 .. [2] R. L. Norton, *Design of Machinery*, 5th ed., McGraw-Hill, 2012, ch. 4 and 7
    (Grashof condition, loop-closure equations and their derivatives).
 
-Stage 2 (mechanisms, independent of fe): uses only mechanisms.position.
+Uses only mechanisms.position.
 """
 
 from dataclasses import dataclass

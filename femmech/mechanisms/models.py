@@ -7,7 +7,7 @@ cached per mechanism, so building many models with different parameter values is
 
 Symbols follow the seed chapter: M mass, B damping, C stiffness, F force (5.2.2 eq. 9).
 
-Stage 2 (mechanisms, independent of fe): uses mechanisms.symbolic, .lagrange, .evaluate and
+Uses mechanisms.symbolic, .lagrange, .evaluate and
 .position.
 """
 

@@ -28,7 +28,7 @@ References
    2009, ch. 3 (double-dwell functions) and Table 3-3 (peak values of s', s'', s''').
 .. [2] H. A. Rothbart, *Cam Design Handbook*, McGraw-Hill, 2004, ch. 2.
 
-Stage 2 (mechanisms, independent of fe): uses only mechanisms.position.
+Uses only mechanisms.position.
 """
 
 from dataclasses import dataclass, field

@@ -21,7 +21,7 @@ Coordinates are small displacements (m) or rotations (rad) about the rigid motio
 Coordinate meanings, units and signs: :data:`femmech.mechanisms.catalogue.CATALOGUE`
 (docs/mechanisms.md, "Reference of the built-in mechanisms").
 
-Stage 2 (mechanisms, independent of fe): uses mechanisms.symbolic and .catalogue.
+Uses mechanisms.symbolic and .catalogue.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ mechanism equations need U and its first three derivatives with respect to φ: U
 enter the mass and damping terms, U''' enters the stiffness matrix C (seed chapter
 5.2.2, text after Table 5.1).
 
-Stage 2 (mechanisms, independent of fe): imports nothing of femmech.
+Imports nothing of femmech.
 """
 
 from typing import Protocol, runtime_checkable

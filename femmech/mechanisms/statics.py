@@ -23,7 +23,7 @@ Two models, two meanings of "static":
   loads; with the drive speed, the quasi-static deflection including the rigid-body
   inertia forces. One linear solve (exact for the linear model), vectorised over angles.
 
-Stage 2 (mechanisms, independent of fe): uses mechanisms.models and errors.
+Uses mechanisms.models and errors.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ Position functions of cams and linkages enter as opaque sympy functions made by
 derivatives are the opaque functions U', U'', U'''. Their numeric values are supplied
 when the equations are evaluated (see :mod:`femmech.mechanisms.evaluate`).
 
-Stage 2 (mechanisms, independent of fe): imports nothing of femmech.
+Imports nothing of femmech.
 """
 
 import functools

@@ -10,7 +10,7 @@ References
 ----------
 .. [1] C. de Boor, *A Practical Guide to Splines*, rev. ed., Springer, 2001.
 
-Stage 2 (mechanisms, independent of fe): uses only mechanisms.position.
+Uses only mechanisms.position.
 """
 
 from dataclasses import dataclass, field

@@ -23,7 +23,7 @@ neither.
 * :mod:`.folder`: one run, one output folder (staging folder and manifest);
   :mod:`.folder_swap`: its crash-safe swap (run lock, journal, recovery of killed runs).
 
-Stage 7 (output): uses analysis, coupling, reduction, fe and errors; of femmech only
+Uses analysis, coupling, reduction, fe and errors; of femmech only
 :mod:`femmech.scene` imports it.
 """
 

@@ -7,7 +7,7 @@ an artefact of re-scaling; the header states the mode, frequency and magnificati
 the still images. Frames are written by Pillow (a matplotlib dependency); the GIF is
 written atomically.
 
-Stage 7 (output): uses analysis.modes and output.plot (pyvista inside).
+Uses analysis.modes and output.plot (pyvista inside).
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ on a 1024 x 768 image.
 The texts are composed by pure functions (:func:`format_factor`, :func:`scale_text`,
 :data:`COLOUR_BAR_TITLE`) so that tests can check them without rendering.
 
-Stage 7 (output): uses nothing of femmech (PIL, matplotlib's font files and colour map).
+Uses nothing of femmech (PIL, matplotlib's font files and colour map).
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ axes (right ``x``, up ``y``, depth ``z``), a point is inside the image when
 linear in the camera's lateral offset ``c`` and distance ``D``, and the smallest ``D``
 and its centred ``c`` follow in closed form (:func:`fit_camera`).
 
-Stage 7 (output): uses nothing of femmech.
+Uses nothing of femmech.
 """
 
 from __future__ import annotations

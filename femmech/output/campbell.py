@@ -13,7 +13,7 @@ speed range, the resonance is marked (red segment, dot at the mean). An optional
 :class:`~femmech.chain.synthesis.SynthesisResult` and :func:`plot_margins` its margin per
 branch.
 
-Stage 7 (output): uses output.charts and output.export, and the band geometry of
+Uses output.charts and output.export, and the band geometry of
 femmech.chain.synthesis; matplotlib is imported inside the functions.
 """
 

@@ -6,7 +6,7 @@ of the boxes already placed and of obstacles (a legend, a colour bar). It is a p
 function (:func:`place_labels`), so it is tested without drawing; the chart modules turn
 text extents into candidate boxes and the chosen boxes back into text positions.
 
-Stage 7 (output): imports nothing of femmech; matplotlib objects come in duck-typed.
+Imports nothing of femmech; matplotlib objects come in duck-typed.
 """
 
 from __future__ import annotations

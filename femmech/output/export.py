@@ -4,7 +4,7 @@ Every writer in :mod:`femmech.output` goes through :func:`atomic_path`: the data
 written to a temporary file in the target folder and renamed onto the target with
 :func:`os.replace`, so a failure never leaves a half-written file behind.
 
-Stage 7 (output): uses analysis.modes, fe and output.surfaces.
+Uses analysis.modes, fe and output.surfaces.
 """
 
 from __future__ import annotations

@@ -19,7 +19,7 @@ manifest missing, or no regular file: a link, FIFO, device, directory or larger 
 :data:`~femmech.output.folder_swap.MAX_MANIFEST_BYTES`) is refused, so ``--out`` can
 never make femmech delete a user's files.
 
-Stage 7 (output): uses errors and :mod:`.folder_swap`.
+Uses errors and :mod:`.folder_swap`.
 """
 
 from __future__ import annotations

@@ -26,7 +26,7 @@ user file is never removed; if a file cannot be moved, the folder stays with a w
 naming it. Siblings of an older femmech without a lock file are judged by their pid and
 age (:data:`STALE_AGE`), and an ``old`` folder kept so is named in a warning.
 
-Stage 7 (output): uses errors and the regular-file reader of :mod:`femmech.reduction`.
+Uses errors and the regular-file reader of :mod:`femmech.reduction`.
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ One function, :func:`format_value`, turns every number of the report into text:
 :class:`Quantity` carries a value with its unit and digits into a report table cell
 (:func:`femmech.output.report.render_table` formats bare floats with the defaults).
 
-Stage 7 (output): imports nothing of femmech.
+Imports nothing of femmech.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Time histories of a forced response: panels over time, orbits, CSV tables.
 
-Stage 7 (output): uses output.export (atomic writes) and output.charts (angle ticks);
+Uses output.export (atomic writes) and output.charts (angle ticks);
 arrays come in, and matplotlib is imported inside the functions.
 """
 

@@ -12,7 +12,7 @@ view names are those of the mode images (:mod:`femmech.output.renderer`,
 :mod:`femmech.output.camera`), and the axis colours those of their view triad
 (:data:`femmech.output.annotate.AXIS_COLORS`).
 
-Stage 7 (output): uses fe (the model's beam frames), output.annotate, .camera,
+Uses fe (the model's beam frames), output.annotate, .camera,
 .mode_geometry, .renderer and .export.
 """
 

@@ -8,7 +8,7 @@ displaced by the mechanism coordinate of largest amplitude along the attachment
 direction. The title states the frequency, the drive angle (``φ = 45°``) and speed, the
 legend lists the mechanism glyph next to the frame's.
 
-Stage 7 (output): uses analysis.modes, coupling, reduction, fe and output.plot,
+Uses analysis.modes, coupling, reduction, fe and output.plot,
 .mode_geometry, .annotate and .renderer.
 """
 

@@ -13,7 +13,7 @@ springs to the ground do (``K G`` with ``G`` the six rigid-body motions), and a 
 between two nodes couples their DOFs in ``K`` while a rigid link or a spider (a
 constraint) does not.
 
-Stage 7 (output): uses fe (model, DOFs, recovery, rigid-body motions) and output.surfaces.
+Uses fe (model, DOFs, recovery, rigid-body motions) and output.surfaces.
 """
 
 from __future__ import annotations

@@ -11,15 +11,15 @@ colour bar with its quantity, a legend of exactly the glyphs drawn and an x-y-z 
 
 All images of one call share one camera, fitted to the undeformed model and every
 drawn deformed shape (:func:`femmech.output.camera.fit_camera`), and one off-screen
-scene whose points and scalars are replaced per mode (0.08 s per 1024 x 768 image
-after a set-up of 0.1 s on 2 cores, plus pyvista's import; benchmarks/mode_images.py);
+scene whose points and scalars are replaced per mode (benchmarks/mode_images.py times
+it);
 :func:`plot_modes` can spread images over worker processes (``workers``).
 
 The drawing does not depend on shell thickness, and the plotter has its own document
 theme, so the global pyvista theme does not change the image. pyvista is imported
 only inside the functions.
 
-Stage 7 (output): uses analysis.modes and .mode_types, fe and output.export,
+Uses analysis.modes and .mode_types, fe and output.export,
 .mode_geometry, .camera, .annotate and .renderer.
 """
 

@@ -23,7 +23,7 @@ window (or to OSMesa when only libOSMesa is found) before the first render windo
 created, unless the variable is already set; this skips the failing X attempt and its
 warning.
 
-Stage 7 (output): uses fe.dofs and output.mode_geometry, .camera and .annotate.
+Uses fe.dofs and output.mode_geometry, .camera and .annotate.
 """
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ log) is text: the page is built by :func:`femmech.html.element`, which escapes i
 once, so a scene name or group name holding ``<script>`` shows as written and never runs.
 Link targets must be relative paths (:func:`femmech.html.url`).
 
-Stage 7 (output): uses html, output.export and output.formatting.
+Uses html, output.export and output.formatting.
 """
 
 from __future__ import annotations

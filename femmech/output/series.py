@@ -26,7 +26,7 @@ renamed into place, then the collection file is written (its own atomic rename),
 file is ever half-written and a failure while the steps are written leaves the previous
 series whole.
 
-Stage 7 (output): uses fe, coupling, output.machine (recovery of the frame's full
+Uses fe, coupling, output.machine (recovery of the frame's full
 fields) and output.export (checks, cells, atomic writes); meshio only.
 """
 

@@ -12,7 +12,7 @@ What a chart draws, and nothing else is claimed by its title or legend:
   (:func:`femmech.output.charts.label_vertical_marks`);
 * one legend, outside the plot.
 
-Stage 7 (output): uses output.export (atomic writes) and output.charts; charts and
+Uses output.export (atomic writes) and output.charts; charts and
 studies (:mod:`femmech.analysis.stability`) come in duck-typed, and matplotlib is imported
 inside the functions.
 """

@@ -7,7 +7,7 @@ connectivity), are drawn by their outer surface: the faces that belong to exactl
 solid cell. Higher-order solids (``tetra10``, ``hexahedron20``, ...) are drawn with
 their corner nodes, which meshio lists first.
 
-Stage 7 (output): uses only fe.model.
+Uses only fe.model.
 """
 
 from __future__ import annotations

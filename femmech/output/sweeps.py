@@ -5,7 +5,7 @@ quasi-mode tables (CSV, JSON).
 (mechanism-only :class:`~femmech.mechanisms.QuasiModes` or a coupled
 :class:`~femmech.analysis.sweep.Sweep`).
 
-Stage 7 (output): uses output.export (atomic writes) and output.charts; results come in
+Uses output.export (atomic writes) and output.charts; results come in
 duck-typed, and matplotlib is imported inside the functions.
 """
 

@@ -1,6 +1,6 @@
 """Frequency tables of a mode set: plain text for reports and logs, CSV for spreadsheets.
 
-Stage 7 (output): uses analysis.modes, analysis.discretisation and output (export,
+Uses analysis.modes, analysis.discretisation and output (export,
 formatting, report).
 """
 

@@ -9,7 +9,7 @@
 * :mod:`.registry`: the shell and solid cell kinds :func:`femmech.build_model` knows;
   each element module registers its kinds, and importing this package imports them all.
 
-Stage 2 (fe): uses only fe.assembly and fe.dofs (in :mod:`.solid`).
+Uses only fe.assembly and fe.dofs (in :mod:`.solid`).
 """
 
 from femmech.fe.elements import shell, shell6, shell9, solid  # noqa: F401  (they register their kinds)

@@ -18,7 +18,7 @@ Two families, by the properties and DOFs they take:
     sparse stiffness and mass (n_dof, n_dof) on the 6-DOF-per-node numbering, rotations
     left empty; material arrays (n_elements,).
 
-Stage 2 (fe): uses only fe.mesh (the node count of each cell kind); the element modules
+Uses only fe.mesh (the node count of each cell kind); the element modules
 import it.
 """
 

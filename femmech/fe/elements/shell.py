@@ -65,7 +65,7 @@ Finite Elements: Their Design and Performance, 1994), so that rigid-body motions
 real nodes give zero strain energy. Warping makes the element less accurate; keep ``z₀``
 small compared to the element size.
 
-Stage 2 (fe): imports nothing of femmech; arrays in, element matrices out.
+Imports nothing of femmech; arrays in, element matrices out.
 """
 
 from __future__ import annotations

@@ -65,7 +65,7 @@ Mass: consistent, from the quadratic shape functions for all six fields, ``ρ t`
 the translations and ``ρ t³ / 12`` for the rotations, with the same nominal drilling
 inertia ``ρ t³ / 12`` as :mod:`.shell`.
 
-Stage 2 (fe): imports fe.elements.registry and the shared helpers of fe.elements.shell;
+Imports fe.elements.registry and the shared helpers of fe.elements.shell;
 arrays in, element matrices out.
 """
 

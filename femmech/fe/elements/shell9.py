@@ -75,17 +75,15 @@ interpolated. Its rotations stay free: tying them too restricts the MITC9 shear
 interpolation to serendipity rotations, which locks (regular 4 x 4 simply supported
 plate, a/t = 10³: λ₁ +121 %), while the translations alone do not (λ₁ error 5.3e-3 at
 both a/t = 10³ and 10⁴); a skin's free centre rotation is held by its transverse shear,
-near ``sqrt(12 k G / ρ) / (2 π t)`` (16 MHz for a 0.1 mm steel skin). Measured on a
-steel cantilever 0.1 x 0.02 x 0.02 m (6 x 2 x 2 hexahedron20) with a 0.1 mm quad8 skin
-on its end: before, four extra modes at 5.1, 7.0, 7.0 and 8.4 kHz among the solid's
-1.61 (bending), 7.30 (torsion), 8.70 (bending) and 12.7 kHz (axial); now the solid's
-modes only, each lowered by the skin's mass (1e-3 of the solid's) by 1.0e-3 … 2.0e-3,
-as the first-order mass perturbation predicts within 0.6 % (tests/test_quad8_skin.py).
+near ``sqrt(12 k G / ρ) / (2 π t)`` (16 MHz for a 0.1 mm steel skin). An untied centre
+would add spurious modes among the solid's (kHz on a steel cantilever with a 0.1 mm
+quad8 skin on its end); tied, the solid's modes stay, each lowered by the skin's mass as
+the first-order mass perturbation predicts (tests/test_quad8_skin.py).
 Where a node is already at the centre (the face centre of a ``hexahedron27`` under the
-skin), it is the centre node and nothing is tied: the solid holds it (before, the added
-node coincided with it and ``build_model`` refused the mesh).
+skin), it is the centre node and nothing is tied: the solid holds it (an added node
+would coincide with it).
 
-Stage 2 (fe): imports fe.elements.registry and the shared helpers of fe.elements.shell;
+Imports fe.elements.registry and the shared helpers of fe.elements.shell;
 arrays in, element matrices out.
 """
 

@@ -34,7 +34,7 @@ quadratic ones for bending-dominated parts.
 DOFs: ``ux, uy, uz`` per node, node-major (``3 node_local + component``);
 :func:`assemble_solid` places them at femmech's ``6 node + component``.
 
-Stage 2 (fe): uses only fe.assembly and fe.dofs.
+Uses only fe.assembly and fe.dofs.
 """
 
 from __future__ import annotations
