@@ -86,7 +86,7 @@ class TabulatedPositionFunction:
             raise ValueError(f"the table is not periodic: U[-1] - U[0] - increment = {gap:.3g}, "
                              f"more than rtol * range = {self.rtol * scale:.3g}")
         periodic[-1] = periodic[0]
-        from scipy.interpolate import make_interp_spline  # 0.5 s of imports: only when used
+        from scipy.interpolate import make_interp_spline  # a slow import: only when used
 
         spline = make_interp_spline(phi, periodic, k=5, bc_type="periodic")
         object.__setattr__(self, "phi", phi)

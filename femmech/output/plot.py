@@ -175,8 +175,7 @@ def plot_modes(model: FEModel, modes: ModeSet, out_dir, indices=None, prefix: st
         Worker processes, each with its own scene (default 1; ignored with a
         ``decorate`` callable). Spawned workers import the main script, which then needs
         an ``if __name__ == "__main__":`` guard. On 2 cores a pool does not pay
-        (48 images of the frame example: 4.0-4.8 s in one process, 4.5 s on 2 workers;
-        12 images: 1.0 s and 2.4 s): Mesa's software OpenGL already renders on every
+        (benchmarks/mode_images.py): Mesa's software OpenGL already renders on every
         core, and each worker pays the start-up of Python, VTK and a render window.
     progress : callable, optional
         Wraps the iterable of image numbers drawn, e.g. a ``tqdm`` progress bar (serial

@@ -4,9 +4,8 @@
 then, per mode, only replaces points and scalars: the deformed beam curves feed VTK tube
 and glyph filters (a pipeline, so the tubes follow their curves at the next render), the
 shell and solid surfaces move in place, the undeformed ghost, the supports and the
-camera stay. Building the scene and compiling its shaders takes most of a first image
-(about 1 s with Mesa's software OpenGL); the following images cost a render and a
-read-back of the pixels.
+camera stay. Building the scene and compiling its shaders takes most of a first image;
+the following images cost a render and a read-back of the pixels.
 
 What is drawn: tubes along the element curves coloured by ``|u| / max |u|`` with
 spheres at the nodes, shells and solid surfaces flat-shaded with thin edges on the same

@@ -79,9 +79,9 @@ DRILLING = 1e-2
 STABILISATION = 0.1
 ELEMENT_CHUNK = 8192
 """Elements per batch of :func:`shell_matrices`: the batch's intermediate arrays (about ten
-of 24 x 24 per quad) stay near 0.4 GB however large the mesh; in one batch the 168k quads
-of a 1M-DOF model needed about 5.6 GB. Results do not depend on it (each element's
-arithmetic is its own)."""
+of 24 x 24 per quad) stay near 0.4 GB however large the mesh, where one batch of all
+elements would grow with it. Results do not depend on it (each element's arithmetic is
+its own)."""
 
 _G = 1.0 / np.sqrt(3.0)
 _QUAD_GAUSS = np.array([[-_G, -_G], [_G, -_G], [_G, _G], [-_G, _G]])

@@ -17,8 +17,8 @@ node locations (``Element.doflocs``, used to permute its local DOFs to meshio's 
 order) and the quadrature rules (``skfem.quadrature.get_quadrature``). The isoparametric
 map and the integrals are batched numpy here, element by element, instead of through
 ``skfem.Basis``: a Basis numbers quadratic DOFs by scikit-fem's own edges and faces,
-while femmech needs the mesh's nodes; and scikit-fem's vector elasticity form was 7-15x
-slower than the scalar derivative blocks used below (project measurement).
+while femmech needs the mesh's nodes; and scikit-fem's vector elasticity form is slower
+than the scalar derivative blocks used below.
 
 Stiffness (linear elasticity, ``σ = λ tr(ε) I + 2 μ ε``, ``λ = 2 G ν / (1 - 2 ν)``,
 ``μ = G``): with ``S_ab[i, j] = ∫ ∂_a φ_i ∂_b φ_j dV``, the 3 x 3 block of nodes i, j is
