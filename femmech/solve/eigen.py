@@ -25,7 +25,7 @@ import numpy as np
 from scipy.sparse.linalg import ArpackNoConvergence
 
 from femmech.errors import FemmechWarning
-from femmech.solve import direct
+from femmech.solve import direct, tolerances
 from femmech.solve.arpack import _arpack
 from femmech.solve.dense import dense_symmetric
 from femmech.solve.lanczos import _FarShiftError, _lowest_pairs
@@ -41,8 +41,9 @@ from femmech.solve.sturm import _complete_cluster, _cut_above, inertia_below
 MAX_DEFLATIONS = 10
 """Deflated Lanczos restarts allowed to complete a set that the Sturm count shows short."""
 
-DENSE_BELOW = 400
-"""Systems with fewer DOFs than this are solved with dense LAPACK (``scipy.linalg.eigh``)."""
+DENSE_BELOW = tolerances.DENSE_BELOW
+"""Systems with fewer DOFs than this are solved with dense LAPACK
+(:func:`~.dense.dense_symmetric`; :data:`femmech.solve.tolerances.DENSE_BELOW`)."""
 
 ARPACK_BELOW = 30_000
 """Below this many DOFs, :func:`_sparse_lowest` with the Sturm check runs ARPACK for the
@@ -70,12 +71,10 @@ over (it also moves a shift far below the wanted eigenvalues,
 :data:`~.lanczos.FAR_SHIFT`). 20 modes of the 5k frame took 2-3 restarts with
 σ/λ₁ = -0.05 … -5, 4 with σ/λ₁ = -50 and 11 with -500."""
 
-RIGID_TOL = 1e-12
-"""Eigenvalues with ``|ω²| <= RIGID_TOL * scale`` are rigid-body modes (scale: a typical
-element eigenvalue, e.g. :func:`femmech.analysis.modes.model_eigenvalue_scale`). Computed
-rigid-body eigenvalues are ~1e-17 of the scale, of either sign (also on free shells at
-span/thickness 1e4, whose lowest elastic eigenvalue is 3e-10 of it); elastic modes of
-1e-12 of the scale are ~1e-6 of the typical element frequency."""
+RIGID_TOL = tolerances.RIGID_TOL
+"""Eigenvalues with ``|ω²| <= RIGID_TOL * scale`` are rigid-body modes
+(:data:`femmech.solve.tolerances.RIGID_TOL`, which says why 1e-12; scale: a typical
+element eigenvalue, e.g. :func:`femmech.analysis.modes.model_eigenvalue_scale`)."""
 
 
 @dataclass(frozen=True)
