@@ -34,9 +34,10 @@ import peers  # noqa: E402
 from coupled_sweep import _example  # noqa: E402
 
 from femmech.analysis import sweep as sweep_module  # noqa: E402
+from femmech.analysis import tracking  # noqa: E402
 from femmech.coupling import assemble_stack, couple  # noqa: E402
 from femmech.reduction.component_modes import craig_bampton  # noqa: E402
-from femmech.solve import threads  # noqa: E402
+from femmech.solve import dense, threads  # noqa: E402
 
 TARGET, N_MODES = 1.3, 6
 # size: (reduced sizes r, angles)
@@ -81,7 +82,7 @@ def candidates(M, C, n_modes: int) -> int:
     extra = min(n_modes + max(2, n_modes // 2), n - 1)
     while extra < n - 1:
         f = sweep_module._lean_solve(M[:1], C[:1], extra)[2]
-        if sweep_module._splits(f)[:, n_modes - 1:].any():
+        if tracking.splits(f)[:, n_modes - 1:].any():
             break
         extra = min(2 * extra, n - 1)
     return extra
@@ -95,8 +96,8 @@ def lapack_floor(M, C, q: int):
                               / np.diagonal(M, axis1=1, axis2=2), axis=1)
     Mf = np.ascontiguousarray(M.transpose(0, 2, 1))
     Af = np.ascontiguousarray((C - sigma[:, None, None] * M).transpose(0, 2, 1))
-    solve = (sweep_module._sygvd if q >= sweep_module.ALL_PAIRS_FRACTION * n
-             else sweep_module._sygvx)
+    solve = (dense.sygvd_largest if q >= dense.ALL_PAIRS_FRACTION * n
+             else dense.sygvx_largest)
 
     def run():
         Mc, Ac = Mf.copy(), Af.copy()

@@ -374,3 +374,23 @@ def test_band_from_zero_with_a_given_factor_is_found_as_the_lowest_modes(monkeyp
     assert made == []  # the given factor served the shift
     assert result.omega2.size == result.sturm_count == 12
     assert_allclose(result.omega2, ref[:12], rtol=0, atol=eigenvalue_atol(K, M))
+
+
+@pytest.mark.parametrize("path", PATHS)
+def test_method_names_the_algorithm_that_ran(monkeypatch, path):
+    # EigenResult.method says which algorithm computed the pairs: "block-lanczos" where
+    # femmech's block Lanczos ran (it said "arpack" there), "arpack" where ARPACK did.
+    # Reference eigenvalues: the fixed-free spring chain's closed form
+    # λ_j = 4 k/m sin²((2j - 1) π / (2 (2n + 1))) (Rayleigh, Theory of Sound §120).
+    _path(monkeypatch, path)
+    n, k, m = 600, 1e6, 1.0
+    main = np.full(n, 2 * k)
+    main[-1] = k
+    K = sp.diags([main, -k * np.ones(n - 1), -k * np.ones(n - 1)], [0, 1, -1]).tocsc()
+    M = sp.identity(n, format="csc") * m
+    result = eigen.solve_symmetric(K, M, n_modes=5)
+    assert result.method == path.removesuffix("-first")
+    j = np.arange(1, 6)
+    exact = 4 * k / m * np.sin((2 * j - 1) * np.pi / (2 * (2 * n + 1))) ** 2
+    # bound: Lanczos converged to LANCZOS_TOL 1e-12 relative (ARPACK to eps) -> 1e-9 safe
+    assert_allclose(result.omega2[:5], exact, rtol=1e-9)

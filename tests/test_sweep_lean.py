@@ -8,6 +8,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 import femmech as fm
 from femmech.analysis import sweep as sw
+from femmech.analysis import tracking
 from femmech.coupling import Mount, couple
 from femmech.fe import sections
 from femmech.mechanisms import (
@@ -117,7 +118,7 @@ def test_unsymmetric_angle_falls_back():
 
 
 def test_splits_give_the_clusters():
-    # _splits (all angles at once) must group exactly as clusters() on sorted frequencies:
+    # tracking.splits (all angles at once) must group exactly as clusters() on sorted frequencies:
     # near repeats within CLUSTER_RTOL, chains of them, and rigid-body modes at round-off.
     rng = np.random.default_rng(7)
     base = np.sort(rng.uniform(1.0, 100.0, (40, 12)), axis=1)
@@ -126,11 +127,11 @@ def test_splits_give_the_clusters():
     base[:, 6] = base[:, 5] * (1 + 0.9 * sw.CLUSTER_RTOL)  # a chained triple
     base[::2, :2] = [1e-9, 3e-9]  # rigid-body modes
     f = np.sort(base, axis=1)
-    split = sw._splits(f)
+    split = tracking.splits(f)
     for row, s in zip(f, split, strict=True):
         expected = [g.tolist() for g in sw.clusters(row) if g.size > 1]
-        assert [g.tolist() for g in sw._groups(s)] == expected
-    assert any(len(sw._groups(s)) >= 2 for s in split)
+        assert [g.tolist() for g in tracking._groups(s)] == expected
+    assert any(len(tracking._groups(s)) >= 2 for s in split)
 
 
 def test_batched_span_mac_equals_per_angle():
@@ -147,9 +148,9 @@ def test_batched_span_mac_equals_per_angle():
     split = np.ones((k, q - 1), dtype=bool)
     split[:, 0] = split[:, 1] = False  # cluster 0..2
     split[1:, 4] = False  # cluster 4..5 at angles 1..4
-    out = sw._batch_span_mac(S, nx, G, split, mac)
+    out = tracking._batch_span_mac(S, nx, G, split, mac)
     for j in range(k):
-        expected = sw._span_mac(S[j], nx[j], G[j], sw._groups(split[j]), mac[j])
+        expected = tracking._span_mac(S[j], nx[j], G[j], tracking._groups(split[j]), mac[j])
         # bound: batched and per-angle span MAC: the same products, ~n eps of O(1) values
         assert_allclose(out[j], expected, rtol=0, atol=1e-12)
     assert (out[:, :, :3] > mac[:, :, :3] + 1e-6).any()  # the span MAC differs from the MAC
@@ -214,7 +215,7 @@ def test_row_minima_agree_with_the_hungarian_assignment():
     cost[::3, :, 0] = 0.0  # every row's minimum in column 0: not greedy
     cost[1::7, 0, 5] = cost[1::7, 0, 6] = -1.0  # a tie in row 0: not greedy
     sub = rng.uniform(0.0, 1.0, cost.shape)
-    best, best_sub, greedy = sw._row_minima(sub, cost)
+    best, best_sub, greedy = tracking._row_minima(sub, cost)
     assert greedy.any()
     assert not greedy.all()
     assert not greedy[::3].any()

@@ -18,11 +18,13 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from femmech.analysis.sweep import SYMMETRY_RTOL, mac_matrix, sweep
+from femmech.analysis.sweep import sweep
+from femmech.analysis.tracking import mac_matrix
 from femmech.coupling import CoupledSystem
 from femmech.reduction.superelement import Superelement
 from femmech.solve.eigen import solve_symmetric
 from femmech.solve.pencil import default_shift
+from femmech.solve.tolerances import SYMMETRY_RTOL
 
 
 def full_modes(system: CoupledSystem, phi: float, n_modes: int, Omega: float = 0.0):

@@ -19,7 +19,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
-from femmech.analysis.sweep import Sweep, assign_branches, clusters, cuts_cluster
+from femmech.analysis.sweep import Sweep
+from femmech.analysis.tracking import assign_branches, clusters, cuts_cluster
 from femmech.chain.results import ChainModes
 from femmech.chain.transfer import assembled_modes, transfer_modes
 

@@ -53,7 +53,7 @@ from scipy.optimize import minimize
 from scipy.special import logsumexp
 from scipy.stats import qmc
 
-from femmech.solve import threads
+from femmech.solve import dense, threads, tolerances
 
 DEFAULT_ANGLES = 72
 """Drive angles sampled over one revolution (every 5°) when none are given."""
@@ -364,31 +364,24 @@ def band_distance(freq_hz, lo_hz, hi_hz) -> np.ndarray:
 def frozen_eigen(M, C, phi=None) -> tuple[np.ndarray, np.ndarray]:
     """All eigenpairs of ``C v = λ M v`` at each angle (batched, dense).
 
-    M (n_angles, n, n) symmetric positive definite, C symmetric. Returns λ (n_angles, n)
-    ascending (λ = ω², rad²/s²) and V (n_angles, n, n), M-normalised columns.
+    M (n_angles, n, n) symmetric positive definite, C symmetric (within
+    :data:`femmech.solve.tolerances.SYMMETRY_RTOL`). Returns λ (n_angles, n) ascending
+    (λ = ω², rad²/s²) and V (n_angles, n, n), M-normalised columns: a thin call of
+    :func:`femmech.solve.dense.symmetric_pencil` (``driver="standard"``).
     """
     asym = np.abs(C - np.swapaxes(C, 1, 2)).max(axis=(1, 2))
-    bad = asym > 1e-10 * np.abs(C).max(axis=(1, 2))
+    bad = asym > tolerances.SYMMETRY_RTOL * np.abs(C).max(axis=(1, 2))
     if bad.any():
         raise ValueError(f"C(φ) is not symmetric at {_where(phi, bad)}: synthesis uses the"
                          " frozen problem with Omega = 0 and symmetric loads")
     try:
-        L = np.linalg.cholesky(M)
+        return dense.symmetric_pencil(C, M, driver="standard")
     except np.linalg.LinAlgError:
         ok = np.array([np.all(np.linalg.eigvalsh(m) > 0) for m in M])
+        if ok.all():
+            raise
         raise ValueError(f"M(φ) is not positive definite at {_where(phi, ~ok)} (a"
                          " coordinate without mass?)") from None
-    lam, W = np.linalg.eigh(_standard(M, C, L))
-    return lam, np.linalg.solve(np.swapaxes(L, 1, 2), W)
-
-
-def _standard(M, C, L=None) -> np.ndarray:
-    """``L⁻¹ C L⁻ᵀ`` (symmetrised) with ``M = L Lᵀ``: the standard form of ``C v = λ M v``,
-    batched (n_angles, n, n)."""
-    L = np.linalg.cholesky(M) if L is None else L
-    X = np.linalg.solve(L, C)  # L⁻¹ C
-    A = np.linalg.solve(L, np.swapaxes(X, 1, 2))  # L⁻¹ C L⁻ᵀ
-    return 0.5 * (A + np.swapaxes(A, 1, 2))
 
 
 def _where(phi, mask) -> str:
@@ -544,7 +537,7 @@ class _Problem:
         """The true margin at x alone (one build and eigen solve, no gradient)."""
         M, C = self.matrices(x)
         self.counts["evaluations"] += 1
-        freq = _frequencies(np.linalg.eigvalsh(_standard(M, C)))
+        freq = _frequencies(np.linalg.eigvalsh(dense.standard_form(M, C)))
         return float(_distances(freq, self.lo, self.hi, _kept(freq, self.n_modes)).min())
 
     def _directional(self, x, j, lam, V, g) -> float:

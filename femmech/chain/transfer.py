@@ -49,10 +49,11 @@ import scipy.sparse as sp
 
 from femmech.chain.results import ChainModes
 from femmech.errors import ConvergenceWarning
-from femmech.solve import threads
+from femmech.solve import dense, threads, tolerances
 
-SYMMETRY_RTOL = 1e-10
-"""A unit's C counts as symmetric when ``max|C − Cᵀ| <= SYMMETRY_RTOL · max|C|``."""
+SYMMETRY_RTOL = tolerances.SYMMETRY_RTOL
+"""A unit's C counts as symmetric when ``max|C − Cᵀ| <= SYMMETRY_RTOL · max|C|``
+(:data:`femmech.solve.tolerances.SYMMETRY_RTOL`)."""
 
 REPEATED_RTOL = 1e-9
 """Roots closer than this (relative) get their vectors together (block inverse iteration
@@ -84,15 +85,16 @@ MULTISECTION = 64
 than 4 brackets: a pass evaluates about 4 × MULTISECTION frequencies at most per bracket
 group, so few brackets converge in few passes over the N nodes)."""
 
-ZERO_RTOL = 1e-14
+ZERO_RTOL = tolerances.CHAIN_ZERO_RTOL
 """Roots with |λ| below this times the chain's eigenvalue scale (:func:`_eigenvalue_scale`:
 the trace ratio of C and M over the node rotations) are zero (rigid-body); the count's
 round-off near λ = 0 is about 1e-16 of that scale. Roots reported as zero are checked
-(:data:`ZERO_CHECK`)."""
+(:data:`ZERO_CHECK`); :data:`femmech.solve.tolerances.CHAIN_ZERO_RTOL`."""
 
-DENSE_MAX = 400
+DENSE_MAX = tolerances.DENSE_BELOW
 """``assembled_modes(solver="auto")`` uses dense LAPACK below this many coordinates (and
-for all modes), sparse shift-invert above. Measured, 10 lowest modes of a fixed-free
+for all modes), sparse shift-invert above: the cut-over of
+:data:`femmech.solve.tolerances.DENSE_BELOW`. Measured, 10 lowest modes of a fixed-free
 phased follower chain (one BLAS thread): n = 199 dense 8.6 ms / sparse 12.7 ms, n = 399
 63 / 57 ms, n = 999 324 / 17 ms, n = 1999 1.7 s / 11.5 ms (150x)."""
 
@@ -110,7 +112,7 @@ computed by inverse iteration gives ~1e-16; a soft but elastic mode gives λ m /
 nodes, 1.4e-10 for the 0.048 Hz root of a follower unit without hub inertia). Roots that
 fail are flagged unconverged."""
 
-STURM_CHECK_MAX = 2000
+STURM_CHECK_MAX = tolerances.STURM_CHECK_MAX
 """``transfer_modes(verify=None)`` checks the Wittrick–Williams count against the
 assembled model's Sturm count (an LDLᵀ of C − σM, :func:`femmech.solve.sturm.inertia_below`)
 up to this many coordinates (a few sparse factorisations, ~1 ms each at n = 400)."""
@@ -545,12 +547,12 @@ def _ritz(X, M, C):
     w, Q = np.linalg.eigh(Mp)
     keep = w > MASS_RTOL * max(float(w.max(initial=0.0)), 1e-300)
     if keep.all():  # the usual case: Cholesky of Mp, as accurate as it gets
-        theta, Y = sla.eigh(Cp, Mp)
+        theta, Y = dense.symmetric_pencil(Cp, Mp, driver="plain")
         return theta, X @ Y
     B, N = Q[:, keep] / np.sqrt(w[keep]), Q[:, ~keep]
     Cnn, Cnb = N.T @ Cp @ N, N.T @ Cp @ B
     B = B - N @ np.linalg.lstsq(Cnn, Cnb, rcond=None)[0]  # massless part follows statically
-    theta, Y = sla.eigh(B.T @ Cp @ B, B.T @ Mp @ B)
+    theta, Y = dense.symmetric_pencil(B.T @ Cp @ B, B.T @ Mp @ B, driver="plain")
     return theta, X @ (B @ Y)
 
 
@@ -758,9 +760,9 @@ def assembled_modes(chain, phi: float, n_modes: int | None = None,
 def _dense_pairs(M, C, n_modes, lam_max):
     if n_modes is not None:
         k = min(int(n_modes), M.shape[0])
-        lam, V = sla.eigh(C, M, subset_by_index=[0, k - 1])
+        lam, V = dense.symmetric_pencil(C, M, k, driver="plain")
     else:
-        lam, V = sla.eigh(C, M)
+        lam, V = dense.symmetric_pencil(C, M, driver="plain")
     if lam_max is not None:
         keep = lam < lam_max
         lam, V = lam[keep], V[:, keep]

@@ -7,20 +7,26 @@ At each frozen drive angle φ the generalized eigenproblem
 of the rheolinear model (seed 5.2.2 eq. 9; symbols M mass, C stiffness) is solved, and
 the frequencies f = ω/(2π) are followed over a revolution (seed 5.1: "quasi-
 eigenfrequencies"). With Ω = Ω̇ = 0 and position-independent loads, C is the symmetric
-potential part and ``scipy.linalg.eigh`` is used; otherwise C is generally unsymmetric
-(errata item 30) and ``scipy.linalg.eig`` is used. Damping B is ignored (undamped
-quasi-modes).
+potential part and the symmetric pencil is solved (LAPACK ``sygvd`` of all pairs,
+``driver="plain"`` of :func:`femmech.solve.dense.symmetric_pencil`); otherwise C is
+generally unsymmetric (errata item 30) and QZ is used
+(:func:`femmech.solve.dense.unsymmetric_pencil`). Damping B is ignored (undamped
+quasi-modes). The tracked sweep of a mechanism alone, with damping, is
+:func:`femmech.analysis.sweep.sweep`; it solves the same pencils by the shift-inverted
+driver of the same module (the lowest modes to ~eps relative however wide the spectrum)
+and agrees with :func:`quasi_modes` to round-off.
 
 The diagram of the quasi-eigenfrequencies over the drive angle is
 :func:`femmech.output.sweeps.plot_quasi_frequencies`.
 
-Stage 2 (mechanisms, independent of fe): imports nothing of femmech.
+Stage 2 (mechanisms, independent of fe): imports only :mod:`femmech.solve` (stage 1).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
+
+from femmech.solve import dense, tolerances
 
 __all__ = ["QuasiModes", "frozen_eigen", "quasi_modes"]
 
@@ -63,9 +69,9 @@ def _normalise(v: np.ndarray, M: np.ndarray) -> np.ndarray:
 def _eigen_one(M: np.ndarray, C: np.ndarray, rtol_symmetry: float, rtol_real: float):
     scale = np.max(np.abs(C))
     if np.max(np.abs(C - C.T)) <= rtol_symmetry * scale:
-        lam, v = scipy.linalg.eigh(0.5 * (C + C.T), M)
+        lam, v = dense.symmetric_pencil(0.5 * (C + C.T), M, driver="plain")
         return lam.astype(complex), _normalise(v, M), True
-    lam, v = scipy.linalg.eig(C, M)
+    lam, v = dense.unsymmetric_pencil(C, M)
     order = np.lexsort((lam.imag, lam.real))
     lam, v = lam[order], v[:, order]
     real = np.abs(lam.imag) <= rtol_real * np.abs(lam)
@@ -75,9 +81,14 @@ def _eigen_one(M: np.ndarray, C: np.ndarray, rtol_symmetry: float, rtol_real: fl
     return lam, modes, False
 
 
-def frozen_eigen(M: np.ndarray, C: np.ndarray, rtol_symmetry: float = 1e-12,
-                 rtol_real: float = 1e-9) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Solve C v = λ M v for a stack of frozen-angle matrices.
+def frozen_eigen(M: np.ndarray, C: np.ndarray,
+                 rtol_symmetry: float = tolerances.SYMMETRY_RTOL,
+                 rtol_real: float = tolerances.REAL_RTOL
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Solve C v = λ M v for a stack of frozen-angle matrices (all pairs, dense).
+
+    A thin call of :mod:`femmech.solve.dense` per angle; the bare 3-tuple is kept for
+    callers that unpack it.
 
     Parameters
     ----------
@@ -86,9 +97,11 @@ def frozen_eigen(M: np.ndarray, C: np.ndarray, rtol_symmetry: float = 1e-12,
     C : ndarray (n_angles, n, n)
         Stiffness matrices, symmetric or not.
     rtol_symmetry : float
-        C counts as symmetric if max|C − Cᵀ| <= rtol_symmetry · max|C|.
+        C counts as symmetric if max|C − Cᵀ| <= rtol_symmetry · max|C|; default
+        :data:`femmech.solve.tolerances.SYMMETRY_RTOL`.
     rtol_real : float
-        λ counts as real if |Im λ| <= rtol_real · |λ|.
+        λ counts as real if |Im λ| <= rtol_real · |λ|; default
+        :data:`femmech.solve.tolerances.REAL_RTOL`.
 
     Returns
     -------

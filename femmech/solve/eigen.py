@@ -25,7 +25,7 @@ import numpy as np
 from scipy.sparse.linalg import ArpackNoConvergence
 
 from femmech.errors import FemmechWarning
-from femmech.solve import direct
+from femmech.solve import direct, tolerances
 from femmech.solve.arpack import _arpack
 from femmech.solve.dense import dense_symmetric
 from femmech.solve.lanczos import _FarShiftError, _lowest_pairs
@@ -41,8 +41,9 @@ from femmech.solve.sturm import _complete_cluster, _cut_above, inertia_below
 MAX_DEFLATIONS = 10
 """Deflated Lanczos restarts allowed to complete a set that the Sturm count shows short."""
 
-DENSE_BELOW = 400
-"""Systems with fewer DOFs than this are solved with dense LAPACK (``scipy.linalg.eigh``)."""
+DENSE_BELOW = tolerances.DENSE_BELOW
+"""Systems with fewer DOFs than this are solved with dense LAPACK
+(:func:`~.dense.dense_symmetric`; :data:`femmech.solve.tolerances.DENSE_BELOW`)."""
 
 ARPACK_BELOW = 30_000
 """Below this many DOFs, :func:`_sparse_lowest` with the Sturm check runs ARPACK for the
@@ -70,12 +71,10 @@ over (it also moves a shift far below the wanted eigenvalues,
 :data:`~.lanczos.FAR_SHIFT`). 20 modes of the 5k frame took 2-3 restarts with
 σ/λ₁ = -0.05 … -5, 4 with σ/λ₁ = -50 and 11 with -500."""
 
-RIGID_TOL = 1e-12
-"""Eigenvalues with ``|ω²| <= RIGID_TOL * scale`` are rigid-body modes (scale: a typical
-element eigenvalue, e.g. :func:`femmech.analysis.modes.model_eigenvalue_scale`). Computed
-rigid-body eigenvalues are ~1e-17 of the scale, of either sign (also on free shells at
-span/thickness 1e4, whose lowest elastic eigenvalue is 3e-10 of it); elastic modes of
-1e-12 of the scale are ~1e-6 of the typical element frequency."""
+RIGID_TOL = tolerances.RIGID_TOL
+"""Eigenvalues with ``|ω²| <= RIGID_TOL * scale`` are rigid-body modes
+(:data:`femmech.solve.tolerances.RIGID_TOL`, which says why 1e-12; scale: a typical
+element eigenvalue, e.g. :func:`femmech.analysis.modes.model_eigenvalue_scale`)."""
 
 
 @dataclass(frozen=True)
@@ -90,10 +89,13 @@ class EigenResult:
         Mass-normalised (``XᵀMX = I``); sign fixed so the entry of largest magnitude is
         positive.
     method : str
-        ``"dense"`` (LAPACK) or ``"arpack"``: sparse shift-invert Lanczos (the lowest
-        modes by ARPACK below :data:`ARPACK_BELOW` DOFs, else by femmech's block Lanczos,
-        :func:`~.lanczos._block_lanczos`; bands by ARPACK; the name is kept for the
-        results and tests that select on it).
+        The algorithm that computed the pairs: ``"dense"`` (LAPACK,
+        :func:`~.dense.dense_symmetric`), ``"arpack"`` (ARPACK shift-invert Lanczos: the
+        lowest modes below :data:`ARPACK_BELOW` DOFs with the Sturm check, and bands away
+        from zero), ``"block-lanczos"`` (femmech's block shift-invert Lanczos, the lowest
+        modes otherwise; where it does not converge it falls back to ARPACK with a
+        warning) or ``"sturm"`` (a band from zero that the Sturm count shows empty:
+        nothing to compute).
     sigma : float
         Shift used, rad²/s².
     residual : ndarray (n_modes,)
@@ -210,14 +212,13 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         omega2, X = _select(omega2, X, n_modes, band)
         method = "dense"
     elif n_modes is not None:
-        omega2, X, count, cut, shift = _sparse_lowest(K, M, n_modes, shift, factor, check,
-                                                      scale, movable=sigma is None)
-        method = "arpack"
+        omega2, X, count, cut, shift, method = _sparse_lowest(K, M, n_modes, shift, factor,
+                                                              check, scale,
+                                                              movable=sigma is None)
     elif band[0] == -np.inf and (sigma is None or sigma < 0 or factor is not None
                                  and sigma == 0):
-        omega2, X, count, cut, shift = _sparse_from_zero(K, M, band[1], shift, check, scale,
-                                                         movable=sigma is None, factor=factor)
-        method = "arpack"
+        omega2, X, count, cut, shift, method = _sparse_from_zero(
+            K, M, band[1], shift, check, scale, movable=sigma is None, factor=factor)
     else:
         omega2, X, shift = _sparse_band(K, M, band, sigma, factor)
         method = "arpack"
@@ -279,11 +280,11 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
                    movable=False):
     """Lowest ``n_modes`` eigenpairs (plus the rest of a cut cluster), Sturm-checked.
 
-    Returns ``omega2, X, sturm_count, cut, sigma``. ``movable``: σ is the default shift and
-    may be moved nearer the wanted eigenvalues where it is far from them
-    (:data:`~.lanczos.FAR_SHIFT`; one more factorisation). Where the Sturm count shows that a
-    repeated eigenvalue has more members than Lanczos found, deflated runs add the missing
-    ones.
+    Returns ``omega2, X, sturm_count, cut, sigma, method`` (:func:`_algorithm`).
+    ``movable``: σ is the default shift and may be moved nearer the wanted eigenvalues
+    where it is far from them (:data:`~.lanczos.FAR_SHIFT`; one more factorisation).
+    Where the Sturm count shows that a repeated eigenvalue has more members than Lanczos
+    found, deflated runs add the missing ones.
     The count factorises ``K - cut M`` with the fill-reducing ordering of the shift's
     factorisation (:meth:`femmech.solve.factor.Factor.factorize_like`).
     """
@@ -305,7 +306,7 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
         omega2, X, count, sigma, lu, guard = _guarded_lanczos(K, M, n_modes, sigma, lu,
                                                               movable, guard, limit)
     if not check:
-        return omega2[:count], X[:, :count], None, None, sigma
+        return omega2[:count], X[:, :count], None, None, sigma, _algorithm(guarded)
     for _ in range(MAX_DEFLATIONS):
         # every computed eigenvalue up to the cut counts: where the cut (a relative 1e-6
         # above the last wanted one, or the absolute floor of the scale) passes further
@@ -319,9 +320,9 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
                                                                   movable, guard, limit)
             cut = _cut_above(omega2[count - 1], scale)
         if below is None:
-            return omega2[:count], X[:, :count], None, cut, sigma
+            return omega2[:count], X[:, :count], None, cut, sigma, _algorithm(guarded)
         if below == inside:
-            return omega2[:inside], X[:, :inside], below, cut, sigma
+            return omega2[:inside], X[:, :inside], below, cut, sigma, _algorithm(guarded)
         if below < inside:
             raise RuntimeError(f"Sturm check: {below} eigenvalues lie below {cut:.6g} rad²/s²"
                                f" but the solver returned {inside}")
@@ -333,6 +334,12 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
         count = _complete_cluster(omega2, min(n_modes, omega2.size))
     raise RuntimeError(f"Sturm check: eigenvalues below {cut:.6g} rad²/s² still missing after"
                        f" {MAX_DEFLATIONS} deflated restarts; try another sigma")
+
+
+def _algorithm(guarded: bool) -> str:
+    """:attr:`EigenResult.method` of :func:`_sparse_lowest`: block Lanczos computed the pairs
+    (``guarded``), or ARPACK with the Sturm count as the guard."""
+    return "block-lanczos" if guarded else "arpack"
 
 
 def _guarded_lanczos(K, M, n_modes, sigma, lu, movable, guard, limit):
@@ -367,7 +374,8 @@ def _sparse_from_zero(K, M, hi, sigma, check, scale, movable, factor=None):
     singular K (rigid-body modes, computed λ of either sign) is never factorised, or with
     a given ``factor`` of ``K - σM`` (σ <= 0: the ``K_ii`` of a Craig-Bampton reduction at
     σ = 0), and Sturm-checked there (the count reuses the ordering of the factorisation of
-    ``K - σM``). Returns ``omega2, X, sturm_count, cut, sigma``. (With a factor this path
+    ``K - σM``). Returns ``omega2, X, sturm_count, cut, sigma, method`` (``"sturm"`` where the
+    count shows the band empty). (With a factor this path
     replaced ARPACK at the given shift (:func:`_sparse_band`) for the fixed-interface modes
     up to 176 Hz of the 150k-DOF rails frame of benchmarks/peer_interface.py, 25 modes:
     2.2 s with block Lanczos against 2.7-3.1 s with ARPACK, the same eigenvalues to
@@ -380,14 +388,15 @@ def _sparse_from_zero(K, M, hi, sigma, check, scale, movable, factor=None):
         raise RuntimeError("band search needs a Sturm count, which failed for this pencil;"
                            " ask for n_modes instead")
     if n_below == 0:
-        return np.empty(0), np.empty((K.shape[0], 0)), 0, hi, sigma
-    omega2, X, count, cut, sigma = _sparse_lowest(K, M, n_below, sigma, lu, check, scale,
+        return np.empty(0), np.empty((K.shape[0], 0)), 0, hi, sigma, "sturm"
+    omega2, X, count, cut, sigma, method = _sparse_lowest(K, M, n_below, sigma, lu, check,
+                                                          scale,
                                                   movable=movable)
     keep = omega2 <= hi
     if np.count_nonzero(keep) != n_below:
         raise RuntimeError(f"band search found {np.count_nonzero(keep)} of {n_below}"
                            f" eigenvalues (Sturm count) below {hi:.6g} rad²/s²")
-    return omega2[keep], X[:, keep], count, cut, sigma
+    return omega2[keep], X[:, keep], count, cut, sigma, method
 
 
 def _sparse_band(K, M, band, sigma, factor=None):

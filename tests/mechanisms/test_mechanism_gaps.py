@@ -56,6 +56,20 @@ def test_mechanism_sweep_equals_frozen_quasi_modes(case_1):
     # bound: dense eig of a 2x2 pencil on both sides: eps·cond (roundoff.py)
     assert_allclose(np.sort(result.freq_hz, axis=1), reference.freq_hz, rtol=1e-12)
     assert result.mac_step.min() > 0.9  # the two branches are followed smoothly
+    # independent reference: the roots of det(C - λM) = 0 of each 2x2 pencil in closed
+    # form (a λ² + b λ + c = 0), no LAPACK involved
+    M, C = case_1.M(PHI), case_1.C(PHI, 0.0, 0.0)
+    a = M[:, 0, 0] * M[:, 1, 1] - M[:, 0, 1] * M[:, 1, 0]
+    b = -(M[:, 0, 0] * C[:, 1, 1] + M[:, 1, 1] * C[:, 0, 0] - M[:, 0, 1] * C[:, 1, 0]
+          - M[:, 1, 0] * C[:, 0, 1])
+    c = C[:, 0, 0] * C[:, 1, 1] - C[:, 0, 1] * C[:, 1, 0]
+    root = np.sqrt(b**2 - 4 * a * c)
+    lam = np.sort(np.stack([(-b - root) / (2 * a), (-b + root) / (2 * a)], axis=1), axis=1)
+    exact = np.sqrt(lam) / (2 * np.pi)
+    # bound: quadratic formula with cancellation in -b - root: cond ~ λ2/λ1 ~ 1e2, so
+    # ~1e-14 relative; 1e-10 leaves margin for both dense drivers
+    assert_allclose(np.sort(result.freq_hz, axis=1), exact, rtol=1e-10)
+    assert_allclose(reference.freq_hz, exact, rtol=1e-10)
 
 
 def test_mechanism_sweep_at_speed_and_damped(case_1):
