@@ -44,7 +44,7 @@ from filelock import FileLock, Timeout
 from femmech.errors import CacheWarning
 from femmech.output.export import atomic_path
 from femmech.reduction.superelement import FORMAT_VERSION, Superelement
-from femmech.reduction.superelement_archive import open_regular, read_regular
+from femmech.reduction.superelement_file import open_regular, read_regular
 from femmech.scene.cache_folder import (
     _evict,
     _remove,
