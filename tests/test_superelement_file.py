@@ -27,8 +27,7 @@ from test_reduction import assert_same_superelement as assert_same
 from femmech.errors import FileFormatError
 from femmech.reduction.component_modes import guyan
 from femmech.reduction.superelement import Superelement
-from femmech.reduction.superelement_file import PSD_RTOL, SYMMETRY_RTOL
-from femmech.reduction.superelement_file import FORMAT_VERSION
+from femmech.reduction.superelement_file import FORMAT_VERSION, PSD_RTOL, SYMMETRY_RTOL
 
 FUZZ_FILE = Path(__file__).resolve().parent.parent / "benchmarks" / "fuzz_superelement.py"
 

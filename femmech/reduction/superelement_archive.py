@@ -1,5 +1,6 @@
-"""Old path of the container checks (zip members, npy headers, regular files) of superelement files, now in
-:mod:`femmech.reduction.superelement_file` (the whole file format is in that module).
+"""Old path of the container checks of superelement files (zip members, npy headers,
+regular files), now in :mod:`femmech.reduction.superelement_file` (the whole file format
+is in that module).
 
 Every public name it had works here with a DeprecationWarning naming its new place
 (docs/architecture.md, "Moved names"); nothing inside femmech imports this module.
