@@ -334,10 +334,10 @@ def test_gemm_phase_inside_a_solve_phase_and_back():
 
 def test_cached_library_list_sees_libraries_loaded_later():
     threads.refresh()
-    first = threads._libraries()
-    assert threads._libraries() is first  # cached: no new lookup (~2.5 ms each)
+    first = threads.blas_controller()
+    assert threads.blas_controller() is first  # cached: no new lookup (~2.5 ms each)
     threads.refresh()
-    assert threads._libraries() is not first
+    assert threads.blas_controller() is not first
     with threads.exactly(1):
         assert {lib["num_threads"] for lib in threadpool_info()} == {1}
 
