@@ -48,12 +48,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from femmech.fe.constraints import rigid_link_matrix
-from femmech.fe.dofs import DOF_PER_NODE
+from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE  # noqa: F401 (COMPONENTS: public here too)
 from femmech.fe.elements.beam import PLANE_XY, PLANE_XZ, local_matrices
 from femmech.fe.model import FEModel
 
-COMPONENTS = ("ux", "uy", "uz", "rx", "ry", "rz")
-"""DOF components, in the order of :attr:`ModeType.kinetic`."""
 KINDS = ("axial", "torsion", "bending about y", "bending about z", "springs")
 """Strain energy parts, in the order of :attr:`ModeType.strain` (bending about the
 element's local y and z axes)."""

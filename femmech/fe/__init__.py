@@ -8,7 +8,10 @@ global K, M (:mod:`.assembly`, :mod:`.dofs`) → supports, links, point masses a
 (:mod:`.constraints`, :mod:`.lumped`) → :class:`~femmech.fe.model.FEModel`
 (:mod:`.model`, :mod:`.parts`), with input checks (:mod:`.checks`), field recovery
 inside beam elements (:mod:`.recovery`) and the rigid-body modes the multigrid of the
-LOBPCG solver needs (:mod:`.nullspace`).
+LOBPCG solver needs (:mod:`.nullspace`). Also a Nastran deck's cards
+(:mod:`.nastran_cards`), meshes sized for a frequency band (:mod:`.sizing`) and uniform
+refinement (:mod:`.refine`).
 
-Imports only :mod:`femmech.errors`: no solver, reduction or analysis code.
+Imports :mod:`femmech.errors` and, in :mod:`.nullspace` only, :mod:`femmech.solve.lobpcg`:
+no reduction or analysis code.
 """
