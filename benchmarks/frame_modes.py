@@ -242,8 +242,8 @@ def solve(model):
     targets = [(femmech.solve.eigen, "inertia_below", "sturm"),
                (femmech.solve.eigen, "factorize", "factor"),
                (femmech.solve.eigen, "_arpack", "arpack"),  # bands
-               (femmech.solve.lanczos, "_arpack", "arpack"),  # where block Lanczos gives up
-               (femmech.solve.lanczos, "_block_lanczos", "arpack")]  # lowest modes
+               (femmech.solve.lanczos, "arpack", "arpack"),  # where block Lanczos gives up
+               (femmech.solve.lanczos, "block_lanczos", "arpack")]  # lowest modes
     with peak_memory(row, "eigen_peak_mb"), timer.patched(targets):
         start = time.perf_counter()
         result = fm.modes(model, n_modes=N_MODES)

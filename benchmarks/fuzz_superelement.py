@@ -173,7 +173,7 @@ def pack(members: dict, compression=zipfile.ZIP_DEFLATED, prefix="") -> bytes:
 
 def craft(members: dict) -> dict:
     """Members with meta's SHA-256 sums recomputed (what an attacker can always do)."""
-    from femmech.reduction.superelement_format import field_digest, meta_digest
+    from femmech.reduction.superelement_file import field_digest, meta_digest
 
     try:
         dtype, _, shape, payload = split_npy(members["meta"])

@@ -68,10 +68,10 @@ def child(nx: int, ny: int, nz: int) -> dict:
             finally:
                 label[0] = before
         setattr(module, name, wrapped)
-    for module, name, tag in [(cm, "_factorize_interior", "K_ii factorisation"),
+    for module, name, tag in [(cm, "factorize_interior", "K_ii factorisation"),
                               (eigen, "_lowest_pairs", "Lanczos (fixed-interface modes)"),
                               (eigen, "inertia_below", "Sturm check"),
-                              (cm, "_residual_vectors", "residual vectors"),
+                              (cm, "residual_modes", "residual vectors"),
                               (cm, "_project", "projection")]:
         phase(module, name, tag)
     steel = fm.Material(E=210e9, nu=0.3, rho=7850.0)

@@ -3,6 +3,12 @@
 Importing femmech has no side effects and does not import pyvista (see
 :mod:`femmech.output` for images and files).
 
+Its packages, along the data flow: :mod:`.solve` (sparse linear algebra),
+:mod:`.fe` (the FE model) and :mod:`.mechanisms`, :mod:`.reduction` (superelements),
+:mod:`.coupling` (frame and mechanisms), :mod:`.analysis`, :mod:`.chain`, :mod:`.output`,
+:mod:`.scene` (scene files), :mod:`.cli` and :mod:`.__main__` (the command line); beneath
+them :mod:`.errors`, :mod:`.version`, :mod:`.html` and :mod:`.deprecation` (moved names).
+
 Not a stage: it re-exports the public API of the stages (docs/architecture.md);
 nothing inside femmech imports it.
 """

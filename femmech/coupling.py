@@ -291,7 +291,7 @@ def drive_breakpoints(system: CoupledSystem, angle_period: float = 2 * np.pi) ->
 
 def frame_row(frame, node, direction) -> np.ndarray:
     """Row vector L (n_frame,) with ``Σ w_k u_k(node) = L u`` for frame coordinates u."""
-    w = _weights(direction)
+    w = direction_weights(direction)
     if isinstance(frame, Assembly):
         if not (isinstance(node, tuple) and len(node) == 2):
             raise ValueError("on an Assembly frame, give the node as (part_index, node)")
@@ -328,7 +328,7 @@ def _require_interface(frame, mount: str, att: Attachment) -> None:
         se = frame.parts[part]
     if not isinstance(se, Superelement):
         return
-    w = _weights(att.direction)
+    w = direction_weights(att.direction)
     node_id = _node_id(se, node)
     rows = se.T.tocsr()[DOF_PER_NODE * node_id + np.arange(DOF_PER_NODE)]
     moved = np.asarray(rows.T @ w).ravel()[se.free_interior]
@@ -354,7 +354,7 @@ def _node_id(frame, node) -> int:
                      f" (0..{frame.n_dof // DOF_PER_NODE - 1})")
 
 
-def _weights(direction) -> np.ndarray:
+def direction_weights(direction) -> np.ndarray:
     if isinstance(direction, str):
         if direction not in COMPONENTS:
             raise ValueError(f"unknown direction {direction!r}; use one of {COMPONENTS}"

@@ -10,10 +10,10 @@ def __getattr__(name: str):
     from femmech.deprecation import moved
 
     return moved(__name__, name, {
-        "DOF_PER_NODE": "femmech.solve.lobpcg.DOF_PER_NODE",
+        "DOF_PER_NODE": "femmech.fe.dofs.DOF_PER_NODE",
         "amg_preconditioner": "femmech.solve.lobpcg.amg_preconditioner",
         "lobpcg_symmetric": "femmech.solve.lobpcg.lobpcg_symmetric",
-        "near_nullspace": "femmech.solve.lobpcg.near_nullspace",
-        "node_blocksize": "femmech.solve.lobpcg.node_blocksize",
-        "rigid_body_modes": "femmech.solve.lobpcg.rigid_body_modes",
+        "near_nullspace": "femmech.fe.nullspace.near_nullspace",
+        "node_blocksize": "femmech.fe.nullspace.node_blocksize",
+        "rigid_body_modes": "femmech.fe.nullspace.rigid_body_modes",
     })

@@ -10,11 +10,14 @@ deferred import cannot hide a circle) and checks that
   docs/architecture.md "Moved names") import nothing but :mod:`femmech.deprecation`, and
   nothing inside femmech imports them: they stand outside the stages;
 * no test file imports another test file: shared test models live in helper modules.
+* no module imports another module's underscore name, no UPPER_CASE constant is defined
+  with the same value in two modules, and every package docstring names its modules.
 """
 
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import numpy as np
@@ -302,3 +305,144 @@ def test_registry_refuses_bad_entries():
         registry.ElementType("wedge", "membrane", wedge_matrices)
     assert registry.kinds("shell")[:2] == ("triangle", "quad")  # registration order
     assert "quad9" in registry.kinds("shell")
+
+
+# --- public names across module boundaries, each constant once, package docstrings ---
+
+PRIVATE_IMPORTS_LEFT = {
+    ("femmech.chain.impedance", "_internal_modes"),  # from femmech.chain.transfer
+    ("femmech.solve.arpack", "_n_mass"),  # from femmech.solve.pencil
+    ("femmech.solve.lanczos", "_n_mass"),  # from femmech.solve.pencil
+    ("femmech.solve.eigen", "_n_mass"),  # from femmech.solve.pencil
+    ("femmech.solve.eigen", "_arpack"),  # public: femmech.solve.arpack.arpack
+    ("femmech.solve.eigen", "_FarShiftError"),  # public: femmech.solve.lanczos.FarShiftError
+    ("femmech.solve.eigen", "_lowest_pairs"),  # public: femmech.solve.lanczos.lowest_pairs
+    ("femmech.solve.eigen", "_residual_terms"),  # public: residuals.residual_terms
+    ("femmech.solve.eigen", "_complete_cluster"),  # public: sturm.complete_cluster
+    ("femmech.solve.eigen", "_cut_above"),  # public: femmech.solve.sturm.cut_above
+}
+"""(importing module, name) of the underscore imports still to be switched to public names;
+it only shrinks: an entry that is no longer needed fails the test too."""
+
+CONSTANTS_TWICE_LEFT = {
+    ("femmech.chain.transfer", "SYMMETRY_RTOL"),  # also femmech.analysis.sweep
+    ("femmech.chain.synthesis", "CLUSTER_RTOL"),  # also femmech.analysis.sweep
+    ("femmech.analysis.sweep", "REAL_RTOL"),  # also femmech.reduction.estimate
+    ("femmech.chain.transfer", "REPEATED_RTOL"),  # also femmech.chain.sweep
+}
+"""(module, name) of a constant that repeats another module's definition, still to be
+imported from there; it only shrinks like :data:`PRIVATE_IMPORTS_LEFT`."""
+
+UPPER_CASE = re.compile(r"[A-Z][A-Z0-9_]*")
+
+
+def _is_private(name: str) -> bool:
+    return name.startswith("_") and not name.startswith("__")
+
+
+def private_imports() -> set[tuple[str, str, str]]:
+    """(importing module, imported module, name) of every ``from femmech.x import _name``
+    of another module (relative imports resolved; dunder names are not private)."""
+    found = set()
+    for path in sorted(PACKAGE.rglob("*.py")):
+        name = module_name(path)
+        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not isinstance(node, ast.ImportFrom):
+                continue
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            if target.startswith("femmech") and target != name:
+                found |= {(name, target, alias.name) for alias in node.names
+                          if _is_private(alias.name)}
+    return found
+
+
+def test_no_private_names_across_modules():
+    """What one module takes from another is a public name of it (no underscore)."""
+    found = private_imports()
+    assert ("femmech.solve.eigen", "femmech.solve.pencil", "_n_mass") in found  # the parse works
+    new = sorted(f"{m} imports {n} from {t}: make it public there (drop the underscore)"
+                 for m, t, n in found if (m, n) not in PRIVATE_IMPORTS_LEFT)
+    stale = sorted(f"{m}: {n}" for m, n in PRIVATE_IMPORTS_LEFT - {(m, n) for m, _, n in found})
+    assert not new, "\n".join(new)
+    assert not stale, "no longer imported, remove from PRIVATE_IMPORTS_LEFT:\n" + "\n".join(stale)
+
+
+def literal_constants(path: Path) -> dict[str, str]:
+    """Module-level ``UPPER_CASE = literal`` of ``path``: name → repr of the value. An alias
+    (``A = B``, a name bound by an import or a computation) is no literal and not listed."""
+    found = {}
+    for node in ast.parse(path.read_text(encoding="utf-8")).body:
+        targets = node.targets if isinstance(node, ast.Assign) else (
+            [node.target] if isinstance(node, ast.AnnAssign) and node.value else [])
+        try:
+            value = repr(ast.literal_eval(node.value)) if targets else None
+        except (ValueError, TypeError, SyntaxError, RecursionError):
+            continue
+        found |= {t.id: value for t in targets
+                  if isinstance(t, ast.Name) and UPPER_CASE.fullmatch(t.id)}
+    return found
+
+
+def constants_defined_twice() -> dict[tuple[str, str], list[str]]:
+    """(name, value) → the modules (old paths aside) that define the same UPPER_CASE name
+    with the same literal value, for those defined in more than one module."""
+    old, where = old_paths(), {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        if module_name(path) in old:
+            continue
+        for name, value in literal_constants(path).items():
+            where.setdefault((name, value), []).append(module_name(path))
+    return {key: modules for key, modules in where.items() if len(modules) > 1}
+
+
+def test_each_constant_defined_once():
+    """A constant with the same name and value in two modules is one constant: one module
+    defines it, the other imports it."""
+    twice = constants_defined_twice()
+    offenders = {(m, name) for (name, _), modules in twice.items() for m in modules}
+    new = sorted(f"{name} = {value} in {', '.join(modules)}: define it once, import it"
+                 for (name, value), modules in twice.items()
+                 if not {(m, name) for m in modules} & CONSTANTS_TWICE_LEFT)
+    stale = sorted(f"{m}: {n}" for m, n in CONSTANTS_TWICE_LEFT - offenders)
+    assert not new, "\n".join(new)
+    assert not stale, "defined once now, remove from CONSTANTS_TWICE_LEFT:\n" + "\n".join(stale)
+
+
+def test_constant_checker_sees_literals_only(tmp_path):
+    """The checker lists literal constants and skips aliases and computed values."""
+    path = tmp_path / "m.py"
+    path.write_text("from x import B\nA = 6\nC = B\nD = (1, 'a')\nE = 2 * A\ne = 1\n")
+    assert literal_constants(path) == {"A": "6", "D": "(1, 'a')"}
+
+
+def undocumented_modules() -> list[str]:
+    """``package: module`` for each module or subpackage (old paths aside) that its
+    package's ``__init__`` docstring does not name as ``:mod:`.name```,
+    ``:mod:`package.name``` or ```name```."""
+    old, missing = old_paths(), []
+    for init in sorted(PACKAGE.rglob("__init__.py")):
+        package = module_name(init)
+        if package in old:
+            continue
+        doc = ast.get_docstring(ast.parse(init.read_text(encoding="utf-8"))) or ""
+        members = [p.stem for p in init.parent.glob("*.py") if p != init]
+        members += [d.name for d in init.parent.iterdir() if (d / "__init__.py").is_file()]
+        for member in sorted(members):
+            named = re.search(rf":mod:`~?(?:{re.escape(package)})?\.{member}`|`{member}(?:\.py)?`",
+                              doc)
+            if f"{package}.{member}" not in old and not named:
+                missing.append(f"{package}: {member}")
+    return missing
+
+
+def test_package_docstrings_name_their_modules():
+    """Every package's ``__init__`` docstring names each of its modules, so that reading
+    it is enough to find where something is."""
+    missing = undocumented_modules()
+    assert not missing, "name these in their package's __init__ docstring:\n" + "\n".join(
+        missing)

@@ -408,7 +408,7 @@ def test_full_disk_leaves_no_half_entry_and_no_temporaries(tmp_path, superelemen
 def _manifest_for(data_path: Path, key: str) -> None:
     """A manifest that vouches for whatever ``data_path`` holds (size and SHA-256 right)."""
     manifest = {"key": key, "size": data_path.stat().st_size,
-                "sha256": cache_module._sha256_file(data_path)}
+                "sha256": cache_module.sha256_file(data_path)}
     data_path.with_suffix(".json").write_text(json.dumps(manifest))
 
 

@@ -2,7 +2,7 @@
 chunked shell element batches.
 
 References: dense LAPACK on the same pencil (:func:`femmech.solve.dense.dense_symmetric`,
-shift-inverted, relative accuracy ~eps for the lowest modes), ARPACK (``_arpack``) and a
+shift-inverted, relative accuracy ~eps for the lowest modes), ARPACK (``arpack``) and a
 fresh factorisation of each backend. Tolerances name what limits them: eigenvalues of a
 backward-stable solve are exact for a pencil perturbed by ~eps ‖K‖, so they carry an absolute
 error ~eps λ_max (``roundoff.eigenvalue_atol``), which is the whole difference between two
@@ -69,7 +69,7 @@ def pencil():
                          ids=["partial", "full", "restarted", "b1", "b4"])
 def test_block_lanczos_matches_dense(pencil, variant):
     K, M, sigma, ref, lu = pencil
-    omega2, X = lanczos._block_lanczos(K, M, 14, sigma, lu, n_wanted=12, **variant)
+    omega2, X = lanczos.block_lanczos(K, M, 14, sigma, lu, n_wanted=12, **variant)
     # bound: Ritz residuals <= 1e-12 |θ| give eigenvalue errors ~1e-14; both solvers' round-off
     # ~eps λ_max absolute: 10 eps λ_max = 7.6e-11 of λ_1 (module docstring), within 1e-10.
     # Measured 5.3e-14 for every variant
@@ -90,8 +90,8 @@ def test_block_lanczos_agrees_with_arpack_on_a_larger_frame():
     K, M = model.K_free, model.M_free
     sigma = default_shift(K, M)
     lu = factorize(K - sigma * M, solver="superlu")
-    ref, _ = arpack._arpack(K, M, 24, sigma, lu)
-    omega2, _ = lanczos._block_lanczos(K, M, 24, sigma, lu, n_wanted=20)
+    ref, _ = arpack.arpack(K, M, 24, sigma, lu)
+    omega2, _ = lanczos.block_lanczos(K, M, 24, sigma, lu, n_wanted=20)
     # both round-off of the same pencil, ~eps λ_max absolute: 10 eps λ_max is 1.3e-10 of λ_1
     # and 1.8e-12 of λ_20 (measured 2e-15; rtol 1e-12 was below the bound for λ_1..λ_9)
     assert_allclose(omega2[:20], ref[:20], rtol=0, atol=eigenvalue_atol(K, M))
@@ -104,8 +104,8 @@ def test_block_lanczos_returns_both_members_of_double_eigenvalues():
     K, M = model.K_free, model.M_free
     sigma = default_shift(K, M)
     lu = factorize(K - sigma * M, solver="superlu")
-    omega2, _ = lanczos._block_lanczos(K, M, 8, sigma, lu, n_wanted=6)
-    ref, _ = arpack._arpack(K, M, 8, sigma, lu)  # ARPACK at machine-precision tolerance
+    omega2, _ = lanczos.block_lanczos(K, M, 8, sigma, lu, n_wanted=6)
+    ref, _ = arpack.arpack(K, M, 8, sigma, lu)  # ARPACK at machine-precision tolerance
     # round-off of both, ~eps λ_max absolute: 10 eps λ_max = 1.8e-4 rad²/s², i.e. 3.4e-7 of
     # the first pair (5 287 rad²/s²) and 1e-9 of the third; a missed member would differ by
     # the gap to the next pair, a factor 39 (measured 1.5e-13 relative; the old rtol 1e-12
@@ -123,8 +123,8 @@ def test_block_lanczos_returns_both_members_of_double_eigenvalues():
 
 def test_deflated_block_lanczos_finds_the_next_modes(pencil):
     K, M, sigma, ref, lu = pencil
-    first, X = lanczos._block_lanczos(K, M, 4, sigma, lu)
-    more, _ = lanczos._block_lanczos(K, M, 4, sigma, lu, deflate=X)
+    first, X = lanczos.block_lanczos(K, M, 4, sigma, lu)
+    more, _ = lanczos.block_lanczos(K, M, 4, sigma, lu, deflate=X)
     # bound: round-off of both solvers, 10 eps λ_max = 7.6e-11 of λ_1 (module docstring);
     # measured 5e-14
     assert_allclose(np.sort(np.concatenate([first, more])), ref[:8], rtol=1e-10)
@@ -295,8 +295,8 @@ def test_small_models_take_arpack_for_exactly_the_wanted_pairs(monkeypatch):
     model = tube_cantilever()  # 600 DOFs; pairs of double eigenvalues
     K, M = model.K_free, model.M_free
     calls = []
-    monkeypatch.setattr(lanczos, "_lowest_pairs", _counting(lanczos._lowest_pairs, calls))
-    monkeypatch.setattr(eigen, "_lowest_pairs", lanczos._lowest_pairs)
+    monkeypatch.setattr(lanczos, "lowest_pairs", _counting(lanczos.lowest_pairs, calls))
+    monkeypatch.setattr(eigen, "_lowest_pairs", lanczos.lowest_pairs)
     first = solve_symmetric(K, M, n_modes=5)  # the 5th is a double: the cluster comes back
     assert calls == []  # ARPACK only
     assert first.omega2.size == first.sturm_count == 6
@@ -326,7 +326,7 @@ def test_without_a_count_the_guarded_path_runs(monkeypatch):
     K, M = model.K_free, model.M_free
     monkeypatch.setattr(eigen, "inertia_below", lambda *args, **kw: None)
     calls = []
-    monkeypatch.setattr(eigen, "_lowest_pairs", _counting(lanczos._lowest_pairs, calls))
+    monkeypatch.setattr(eigen, "_lowest_pairs", _counting(lanczos.lowest_pairs, calls))
     result = solve_symmetric(K, M, n_modes=3)
     assert len(calls) == 1
     assert result.sturm_count is None

@@ -250,7 +250,7 @@ def test_constant_curvature_and_shear_energies(name, monkeypatch):
     condensation relaxes the state); constant curvature ``½ κᵀ D_b κ A`` exactly."""
     X, K, _ = _element(name, rotate=False)
     _, xy, _ = shell6.frames6(X, np.arange(6)[None, :])
-    _, _, _, wdet = shell6._quadrature(xy)
+    _, _, _, wdet = shell6.quadrature(xy)
     A = wdet.sum()
     x, y = X[:, 0], X[:, 1]
     g = np.array([4e-4, -3e-4])

@@ -287,10 +287,10 @@ def sized(data):
 
 def split_lines(mesh, k):
     """Every line element split into k (original nodes keep their indices and sets)."""
-    from femmech.fe.generators import _subdivide
+    from femmech.fe.generators import subdivide
 
     groups = {g: mesh.cells["line"][s["line"]] for g, s in mesh.cell_sets.items()}
-    points, cells, cell_sets = _subdivide(mesh.points, groups, k)
+    points, cells, cell_sets = subdivide(mesh.points, groups, k)
     return fm.Mesh(points, {"line": cells}, cell_sets, mesh.node_sets)
 
 

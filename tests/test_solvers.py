@@ -23,7 +23,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 from threadpoolctl import threadpool_info, threadpool_limits
 
 import femmech as fm
-from femmech.fe import sections
+from femmech.fe import nullspace, sections
 from femmech.fe.generators import grid_frame
 from femmech.reduction.component_modes import craig_bampton
 from femmech.solve import direct, lobpcg, pardiso, threads
@@ -333,10 +333,10 @@ def test_gemm_phase_inside_a_solve_phase_and_back():
 
 def test_cached_library_list_sees_libraries_loaded_later():
     threads.refresh()
-    first = threads._libraries()
-    assert threads._libraries() is first  # cached: no new lookup (~2.5 ms each)
+    first = threads.blas_controller()
+    assert threads.blas_controller() is first  # cached: no new lookup (~2.5 ms each)
     threads.refresh()
-    assert threads._libraries() is not first
+    assert threads.blas_controller() is not first
     with threads.exactly(1):
         assert {lib["num_threads"] for lib in threadpool_info()} == {1}
 
@@ -345,15 +345,33 @@ def test_cached_library_list_sees_libraries_loaded_later():
 def test_rigid_body_modes_span_the_null_space_of_a_free_model():
     # u = t + θ × r (and θ on rotation DOFs) is a rigid motion: K_free B = 0 to round-off
     model = frame_model(supported=False)
-    B = lobpcg.near_nullspace(model)
+    B = nullspace.near_nullspace(model)
     K = model.K_free
     assert B.shape == (model.n_free, 6)
     # bound: rigid motions: K B = 0 in exact arithmetic, ~n eps ‖K‖ ‖B‖
     assert np.linalg.norm(K @ B) <= 1e-12 * sp.linalg.norm(K) * np.linalg.norm(B)
     assert np.linalg.matrix_rank(B) == 6
-    assert lobpcg.node_blocksize(model.free) == 6
-    assert lobpcg.node_blocksize(np.array([0, 1, 2, 6, 7, 8])) == 3
-    assert lobpcg.node_blocksize(np.array([0, 1, 3])) == 1
+    assert nullspace.node_blocksize(model.free) == 6
+    assert nullspace.node_blocksize(np.array([0, 1, 2, 6, 7, 8])) == 3
+    assert nullspace.node_blocksize(np.array([0, 1, 3])) == 1
+
+
+def test_lobpcg_sees_arrays_only():
+    """The solver's rigid-body vectors and node blocks take each DOF's node coordinates,
+    component and node: no DOF numbering, no FE model. Two nodes at x = 0 and x = 1 m on
+    the x axis, one with all six components, one with translations only."""
+    x = np.array([[0.0, 0.0, 0.0]] * 6 + [[1.0, 0.0, 0.0]] * 3)
+    component = np.array([0, 1, 2, 3, 4, 5, 0, 1, 2])
+    B = lobpcg.rigid_body_vectors(x, component)
+    # rotation rz about the centroid (x = 1/3 m) moves the second node by 2/3 m in y
+    # (θ × r with θ = e_z, r = (2/3, 0, 0)), exactly representable to round-off
+    assert B[7, 5] == pytest.approx(2.0 / 3.0, rel=1e-15)  # bound: one subtraction, eps
+    assert B[5, 5] == 1.0  # the rz DOF of the first node
+    assert B[3, 5] == 0.0
+    assert lobpcg.node_blocks(np.repeat([0, 1], 3), np.tile([0, 1, 2], 2)) == 3
+    assert lobpcg.node_blocks(np.zeros(6, int), np.arange(6)) == 6
+    assert lobpcg.node_blocks(np.array([0, 0, 0]), np.array([0, 1, 3])) == 1
+    assert "DOF_PER_NODE" not in vars(lobpcg)  # the DOF numbering is stage 2's
 
 
 @pytest.fixture(scope="module")

@@ -11,6 +11,8 @@ independently of :mod:`femmech.reduction.superelement_file`.
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 import importlib.util
 import json
 import struct
@@ -25,8 +27,7 @@ from models import assert_same_superelement as assert_same
 from femmech.errors import FileFormatError
 from femmech.reduction.component_modes import guyan
 from femmech.reduction.superelement import Superelement
-from femmech.reduction.superelement_checks import PSD_RTOL, SYMMETRY_RTOL
-from femmech.reduction.superelement_file import FORMAT_VERSION
+from femmech.reduction.superelement_file import FORMAT_VERSION, PSD_RTOL, SYMMETRY_RTOL
 
 FUZZ_FILE = Path(__file__).resolve().parent.parent / "benchmarks" / "fuzz_superelement.py"
 
@@ -78,6 +79,27 @@ def test_round_trip_is_identical(tmp_path, method):
     assert sorted(meta["sha256"]) == sorted([*fz.FLOAT_MEMBERS, "interface_dofs",
                                              "free_interface", "free_interior", "T_indices",
                                              "T_indptr", "T_shape", "meta"])
+
+
+WRITTEN_SHA256 = "e93f5b38f59728cdfcb06786452de0b97d910c63359957620593edfad00d6b0e"
+"""SHA-256 of the members of the file that the code of commit 7bec911 (before the format's
+modules were merged into one) wrote for the superelement of :func:`test_file_bytes_unchanged`:
+computed once by running that test's hashing on a detached worktree of that commit."""
+
+
+def test_file_bytes_unchanged(tmp_path):
+    """The writer still writes the same members, compressed to the same bytes: per member
+    its name, compression, compressed size, CRC-32 and data (the zip dates, which are the
+    clock's, are left out)."""
+    se = fz.build_superelement()
+    se = dataclasses.replace(se, timings=dict.fromkeys(se.timings, 0.125))  # no clock
+    digest = hashlib.sha256()
+    with zipfile.ZipFile(se.save(tmp_path / "se.npz")) as archive:
+        for info in archive.infolist():
+            digest.update(f"{info.filename}\n{info.compress_type}\n{info.compress_size}\n"
+                          f"{info.CRC}\n".encode())
+            digest.update(archive.read(info))
+    assert digest.hexdigest() == WRITTEN_SHA256
 
 
 def _format_1(base, tmp_path, arrays=None, drop_n_residual=False) -> Path:

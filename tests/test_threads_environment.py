@@ -27,7 +27,7 @@ import json
 import numpy as np
 from threadpoolctl import threadpool_info
 from femmech.solve import pardiso, threads
-assert pardiso._mkl() is not None
+assert pardiso.mkl_library() is not None
 np.ones((4, 4)) @ np.ones((4, 4))
 with threads.limit(solve=1), threads.solve_phase():
     inside = [(lib["internal_api"], lib["num_threads"]) for lib in threadpool_info()]
@@ -35,7 +35,8 @@ print(json.dumps(inside))
 """
 
 
-@pytest.mark.skipif(pardiso._mkl() is None, reason="MKL (pip install femmech[fast]) not installed")
+@pytest.mark.skipif(pardiso.mkl_library() is None,
+                    reason="MKL (pip install femmech[fast]) not installed")
 def test_solve_phase_limits_the_openmp_runtime_mkl_loads_late():
     env = {k: v for k, v in os.environ.items() if k not in ("MKL_NUM_THREADS", "FEMMECH_THREADS")}
     env.update(OMP_NUM_THREADS="2", OPENBLAS_NUM_THREADS="2",

@@ -19,6 +19,9 @@ One job per module:
 * :mod:`.drive_events`: prescribed-drive load cases: static rest, run-up, trip at a
   drive-force limit, braking (a crane's load-moment limiter, a press's overload clutch).
 * :mod:`.studies`: design studies as independent jobs on an executor (processes, Dask).
+* :mod:`.discretisation`: the discretisation error of a model's frequencies by one
+  refinement; :mod:`.participation`: mass properties and modal participation;
+  :mod:`.shell_checks`: spurious drilling modes of shell models.
 
 Uses coupling, reduction, fe, mechanisms, solve and errors; nothing
 here writes files (that is :mod:`femmech.output`).

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from femmech.analysis.response import _drive, _node_component, frame_history
+from femmech.analysis.response import drive_angles, frame_history, node_component
 from femmech.coupling import CoupledSystem, frame_row
 from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
 from femmech.fe.elements.beam import local_matrices
@@ -110,7 +110,7 @@ def attachment_forces(system: CoupledSystem, response, drive=None) -> Attachment
     q = np.asarray(response.q)
     if q.ndim != 2 or q.shape[1] != system.n:
         raise ValueError(f"response.q must have shape (n_t, {system.n}), got {q.shape}")
-    drive_state = None if drive is None else _drive(drive, np.asarray(response.t, float))
+    drive_state = None if drive is None else drive_angles(drive, np.asarray(response.t, float))
     labels, rigid, columns = [], [], []
     for i, mount in enumerate(system.mounts):
         names = list(mount.model.coordinate_names)
@@ -164,7 +164,7 @@ def drive_forces(lagrange, response, drive, system: CoupledSystem | None = None,
         linearisation about the rigid motion).
     """
     t = np.asarray(response.t, dtype=float)
-    phi, Omega, Omega_dot = _drive(drive, t)
+    phi, Omega, Omega_dot = drive_angles(drive, t)
     if system is None:
         states, ratio, phase = (np.asarray(response.q), np.asarray(response.v),
                                 np.asarray(response.a)), 1.0, 0.0
@@ -225,7 +225,7 @@ def support_reactions(system: CoupledSystem, model, response, dofs, mass_coef: f
     """
     d = []
     for dof in dofs:
-        node, component = _node_component(model, dof)
+        node, component = node_component(model, dof)
         d.append(DOF_PER_NODE * int(node) + COMPONENTS.index(component))
     d = np.array(d, dtype=np.int64)
     free = np.zeros(model.n_dof, dtype=bool)

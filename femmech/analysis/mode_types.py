@@ -48,12 +48,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from femmech.fe.constraints import rigid_link_matrix
-from femmech.fe.dofs import DOF_PER_NODE
-from femmech.fe.elements.beam import _PLANE_XY, _PLANE_XZ, local_matrices
+from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE  # noqa: F401 (COMPONENTS: public here too)
+from femmech.fe.elements.beam import PLANE_XY, PLANE_XZ, local_matrices
 from femmech.fe.model import FEModel
 
-COMPONENTS = ("ux", "uy", "uz", "rx", "ry", "rz")
-"""DOF components, in the order of :attr:`ModeType.kinetic`."""
 KINDS = ("axial", "torsion", "bending about y", "bending about z", "springs")
 """Strain energy parts, in the order of :attr:`ModeType.strain` (bending about the
 element's local y and z axes)."""
@@ -71,8 +69,8 @@ _AXES = "xyz"
 _LOCAL = {  # local DOF indices of each beam kind, and the local axis (row of R) it acts about
     "axial": (np.array([0, 6]), 0),
     "torsion": (np.array([3, 9]), 0),
-    "bending about y": (_PLANE_XZ, 1),
-    "bending about z": (_PLANE_XY, 2),
+    "bending about y": (PLANE_XZ, 1),
+    "bending about z": (PLANE_XY, 2),
 }
 
 

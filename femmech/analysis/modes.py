@@ -224,7 +224,8 @@ def is_supported(model: FEModel) -> bool:
 
 
 def _lobpcg(model: FEModel, n_modes, band, sigma):
-    from femmech.solve.lobpcg import lobpcg_symmetric, near_nullspace, node_blocksize
+    from femmech.fe.nullspace import near_nullspace, node_blocksize
+    from femmech.solve.lobpcg import lobpcg_symmetric
 
     if band is not None or sigma is not None or n_modes is None:
         raise ValueError("method='lobpcg' computes the n_modes lowest modes: give n_modes,"

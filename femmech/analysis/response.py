@@ -178,7 +178,7 @@ class SpeedRamp:
         return phi, Omega, Omega_dot
 
 
-def _drive(drive, t):
+def drive_angles(drive, t):
     """φ, Ω, Ω̇ (n_t,) from a drive law object or a tuple of three callables."""
     if isinstance(drive, tuple):
         if len(drive) != 3 or not all(callable(f) for f in drive):
@@ -281,7 +281,7 @@ def time_response(system, t, drive, q0=None, v0=None, rho_inf: float = 0.8) -> R
     Response
     """
     t = _times(t)
-    phi, Omega, Omega_dot = _drive(drive, t)
+    phi, Omega, Omega_dot = drive_angles(drive, t)
     matrices_at = _matrices(system, phi, Omega, Omega_dot)
     n = matrices_at(0)[0].shape[0]
     q0 = _initial(q0, n, "q0")
@@ -523,11 +523,11 @@ def frame_history(system: CoupledSystem, model, q_history, dofs) -> np.ndarray:
                          f" {q_history.shape}")
     from femmech.coupling import frame_row
 
-    rows = np.array([frame_row(system.frame, *_node_component(model, d)) for d in dofs])
+    rows = np.array([frame_row(system.frame, *node_component(model, d)) for d in dofs])
     return q_history[:, :system.n_frame] @ rows.T
 
 
-def _node_component(model, dof):
+def node_component(model, dof):
     if isinstance(dof, (int, np.integer)):
         return int(dof) // DOF_PER_NODE, COMPONENTS[int(dof) % DOF_PER_NODE]
     node, component = dof

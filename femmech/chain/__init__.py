@@ -8,7 +8,8 @@
   ``compare_methods``).
 * :mod:`.cyclic`: uniform chains in closed form per wave number (``cyclic_modes``).
 * :mod:`.continuum`: the smeared continuum (``continuum_modes`` with its error estimate,
-  ``continuum_error_table``, ``validity_problems``).
+  ``continuum_error_table``, ``validity_problems``), with :mod:`.impedance`, the
+  impedance smearing of the units' exact dynamic stiffness.
 * :mod:`.frame`: the chain's units on an elastic (reduced) machine frame (``mount_chain``).
 * :mod:`.synthesis`: design parameters that keep the quasi-eigenfrequencies out of the
   drive harmonics (``synthesise``, ``resonance_margin``).

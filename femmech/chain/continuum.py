@@ -67,9 +67,9 @@ from femmech.chain.cyclic import (
     wave_numbers,
 )
 from femmech.chain.impedance import (
-    _impedance,
-    _impedance_roots,
-    _impedance_vectors,
+    chain_impedance,
+    impedance_roots,
+    impedance_vectors,
 )
 from femmech.chain.results import ChainModes
 
@@ -282,15 +282,15 @@ def continuum_modes(chain, phi: float, n_modes: int, *, ends: str = "cell",
     labels, mu = mode_wave_numbers(c.n_cells, c.g_left, c.g_right, n_modes, ends)
     where = f"continuum at φ = {phi:.6g} rad"
     if smearing == "impedance":
-        imp = _impedance(chain, phi, Omega, Omega_dot)
-        lam, wave = _impedance_roots(imp, c.k * mu**2, c.node_inertia)
+        imp = chain_impedance(chain, phi, Omega, Omega_dot)
+        lam, wave = impedance_roots(imp, c.k * mu**2, c.node_inertia)
         order = np.lexsort((wave, lam))[:n_modes]
         freq = frequencies(lam[order], where)
         label = labels[wave[order]]
         vec = None
         if vectors:
             shapes = mode_shapes(c.n_cells, mu[wave[order]], c.g_left, ends)
-            vec = _impedance_vectors(chain, phi, lam[order], shapes, imp, Omega, Omega_dot)
+            vec = impedance_vectors(chain, phi, lam[order], shapes, imp, Omega, Omega_dot)
     else:
         Mp = c.M.copy()
         Mp[c.attach, c.attach] += c.node_inertia
@@ -349,7 +349,7 @@ def validity_problems(chain, phi: float, modes: ChainModes, ends: str = "cell") 
                    f" (first: f = {modes.freq_hz[i]:.6g} Hz, mode {int(modes.label[i])},"
                    f" μ = {mu_root[i]:.3g}: dispersion ≈ {100 * mu_root[i] ** 2 / 24:.2g} %)")
     if np.ptp(chain.phase) > 0:
-        imp = _impedance(chain, phi, 0.0, 0.0)
+        imp = chain_impedance(chain, phi, 0.0, 0.0)
         with np.errstate(divide="ignore", invalid="ignore"):
             static = imp.caa - np.where(imp.alpha == 0, 0.0, imp.alpha**2 / imp.mu).sum(axis=1)
         spread = float(np.std(static))

@@ -47,7 +47,7 @@ class _Impedance:
         return d
 
 
-def _impedance(chain, phi, Omega, Omega_dot) -> _Impedance:
+def chain_impedance(chain, phi, Omega, Omega_dot) -> _Impedance:
     from femmech.chain.transfer import _internal_modes
 
     Mu, Cu = symmetric_unit_matrices(chain, phi, Omega, Omega_dot)
@@ -73,7 +73,7 @@ def _distinct(values) -> np.ndarray:
     return v[keep]
 
 
-def _impedance_roots(imp: _Impedance, kappa: np.ndarray, J: float) -> tuple:
+def impedance_roots(imp: _Impedance, kappa: np.ndarray, J: float) -> tuple:
     """Roots of h_j(λ) = κ_j − λ J + d̄(λ) = 0 for every κ_j (rad²/s²): one in each
     interval between neighbouring poles of d̄ and below the lowest / above the highest
     (h decreases strictly between poles: dh/dλ = −J − mean_u vᵀ M_u v), plus the
@@ -119,7 +119,7 @@ def _impedance_roots(imp: _Impedance, kappa: np.ndarray, J: float) -> tuple:
     return lam, wave
 
 
-def _impedance_vectors(chain, phi, lam, shapes, imp, Omega, Omega_dot) -> np.ndarray:
+def impedance_vectors(chain, phi, lam, shapes, imp, Omega, Omega_dot) -> np.ndarray:
     """Assembled vectors of the impedance continuum: node rotations Θ_j(x_i), each unit's
     internal coordinates its exact response x_u = −D_ii⁻¹ D_ia Θ_j(x_u) at λ (for a
     decoupled internal root: the unit's internal mode, amplitude Θ_j(x_u), shaft at rest);

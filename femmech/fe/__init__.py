@@ -6,8 +6,12 @@ may not see hidden by :mod:`.deck_lines`) → properties
 (:mod:`.sections`, :mod:`.materials`) → element matrices (:mod:`.elements`) → sparse
 global K, M (:mod:`.assembly`, :mod:`.dofs`) → supports, links, point masses and springs
 (:mod:`.constraints`, :mod:`.lumped`) → :class:`~femmech.fe.model.FEModel`
-(:mod:`.model`, :mod:`.parts`), with input checks (:mod:`.checks`) and field recovery
-inside beam elements (:mod:`.recovery`).
+(:mod:`.model`, :mod:`.parts`), with input checks (:mod:`.checks`), field recovery
+inside beam elements (:mod:`.recovery`) and the rigid-body modes the multigrid of the
+LOBPCG solver needs (:mod:`.nullspace`). Also a Nastran deck's cards
+(:mod:`.nastran_cards`), meshes sized for a frequency band (:mod:`.sizing`) and uniform
+refinement (:mod:`.refine`).
 
-Imports only :mod:`femmech.errors`: no solver, reduction or analysis code.
+Imports :mod:`femmech.errors` and, in :mod:`.nullspace` only, :mod:`femmech.solve.lobpcg`:
+no reduction or analysis code.
 """

@@ -69,7 +69,7 @@ def grid_frame(bays=(2, 2, 2), size=(1.0, 1.0, 1.0), subdivisions: int = 1) -> M
         a = np.delete(ids, -1, axis=axis).ravel()
         b = np.delete(ids, 0, axis=axis).ravel()
         members[name] = np.column_stack([a, b])
-    points, cells, cell_sets = _subdivide(joints, members, subdivisions)
+    points, cells, cell_sets = subdivide(joints, members, subdivisions)
     node_sets = {
         "base": ids[:, :, 0].ravel(),
         "top": ids[:, :, -1].ravel(),
@@ -78,7 +78,7 @@ def grid_frame(bays=(2, 2, 2), size=(1.0, 1.0, 1.0), subdivisions: int = 1) -> M
     return Mesh(points, {"line": cells}, cell_sets, node_sets)
 
 
-def _subdivide(joints, members, k):
+def subdivide(joints, members, k):
     """Split each member into ``k`` elements with new interior nodes (vectorised)."""
     points = [joints]
     cells, cell_sets = [], {}

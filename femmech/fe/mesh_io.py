@@ -26,6 +26,7 @@ import numpy as np
 
 from femmech.errors import FileFormatError, ModelWarning
 from femmech.fe import abaqus_sets, nastran_cards, nastran_sets
+from femmech.fe.checks import MAX_LISTED  # repeated elements named in the warning
 from femmech.fe.mesh import (
     MAX_CELLS,
     MAX_NODES,
@@ -42,8 +43,6 @@ tetrahedra has about 400 MB); a mesh file is untrusted input, refused before rea
 ABAQUS_SUFFIXES = (".inp",)
 NASTRAN_SUFFIXES = (".bdf", ".fem", ".nas")
 """File name endings meshio reads as Abaqus and as Nastran (``meshio.extension_to_filetypes``)."""
-MAX_LISTED = 5
-"""Repeated elements named in the warning; the others are counted."""
 
 
 def from_meshio(mesh, repeats: str = "drop") -> Mesh:

@@ -19,7 +19,11 @@ neither.
 * :mod:`.stability_charts`: Floquet stability charts and speed studies (PNG).
 * :mod:`.histories`: time histories and orbits of a forced response (PNG, CSV).
 * :mod:`.tables`: frequency tables of a mode set (text, CSV).
-* :mod:`.report`: one self-contained HTML report page.
+* :mod:`.report`: one self-contained HTML report page; :mod:`.formatting`: its
+  engineering numbers (value, unit, significant digits).
+* :mod:`.animate`: a mode shape swinging through a period (GIF); :mod:`.series`: result
+  series for ParaView; :mod:`.campbell`: Campbell diagrams of chains;
+  :mod:`.local_axes`: the local axes of beam elements (PNG).
 * :mod:`.folder`: one run, one output folder (staging folder and manifest);
   :mod:`.folder_swap`: its crash-safe swap (run lock, journal, recovery of killed runs).
 

@@ -20,8 +20,8 @@ import numpy as np
 
 from femmech.analysis.modes import ModeSet
 from femmech.fe.model import FEModel
-from femmech.output.export import _check_sizes, _mode_indices, atomic_path
-from femmech.output.plot import _plot, mode_scale, mode_title
+from femmech.output.export import atomic_path, check_sizes, mode_indices
+from femmech.output.plot import mode_scale, mode_title, plot
 
 MAX_FRAMES = 240
 """Most frames of one animation (10 s at 24 frames per second)."""
@@ -61,8 +61,8 @@ def animate_mode(model: FEModel, modes: ModeSet, index: int, filename, n_frames:
         raise ValueError(f"animation file {target.name}: the suffix must be .gif")
     if not target.parent.is_dir():
         raise FileNotFoundError(f"cannot write {target}: folder {target.parent} does not exist")
-    _check_sizes(model, modes)
-    index = int(_mode_indices(modes, [index])[0])
+    check_sizes(model, modes)
+    index = int(mode_indices(modes, [index])[0])
     if int(n_frames) != n_frames or not 4 <= n_frames <= MAX_FRAMES:
         raise ValueError(f"n_frames must be an integer from 4 to {MAX_FRAMES}, got {n_frames}")
     if not 0.5 <= fps <= 50.0:
@@ -75,7 +75,7 @@ def animate_mode(model: FEModel, modes: ModeSet, index: int, filename, n_frames:
     kwargs.setdefault("window_size", (800, 600))  # a GIF of 24 frames: about 0.8 MB
     with tempfile.TemporaryDirectory(prefix="femmech-gif-") as tmp:
         files = [Path(tmp) / f"frame_{k:03d}.png" for k in range(n_frames)]
-        _plot(model, frames, list(range(n_frames)), files, workers=None, scale=scale,
+        plot(model, frames, list(range(n_frames)), files, workers=None, scale=scale,
               mode_type=False, scale_note=True, **kwargs)
         _write_gif(files, target, 1000.0 / fps)
     return target

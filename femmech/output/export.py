@@ -59,7 +59,7 @@ def atomic_path(filename) -> Iterator[Path]:
         tmp.unlink(missing_ok=True)
 
 
-def _mode_indices(modes: ModeSet, indices) -> np.ndarray:
+def mode_indices(modes: ModeSet, indices) -> np.ndarray:
     """Validated 0-based mode indices (all modes by default)."""
     if indices is None:
         return np.arange(modes.n_modes)
@@ -73,7 +73,7 @@ def _mode_indices(modes: ModeSet, indices) -> np.ndarray:
     return idx.astype(np.int64)
 
 
-def _check_sizes(model: FEModel, modes: ModeSet) -> None:
+def check_sizes(model: FEModel, modes: ModeSet) -> None:
     if modes.shapes.shape[0] != model.n_dof:
         raise ValueError(f"the mode shapes have {modes.shapes.shape[0]} DOFs but the model has"
                          f" {model.n_dof}; were they computed for another model?")
@@ -119,8 +119,8 @@ def export_modes_vtu(model: FEModel, modes: ModeSet, filename, indices=None) -> 
     block (VTK XML format, ascii) is added to the file before it is renamed into place.
     In ParaView, "Warp By Vector" with a mode's displacement shows the deformed shape.
     """
-    _check_sizes(model, modes)
-    idx = _mode_indices(modes, indices)
+    check_sizes(model, modes)
+    idx = mode_indices(modes, indices)
     blocks = cell_blocks(model)
     names = sorted({str(g) for _, _, group, _ in blocks for g in group})
     lookup = np.array(names, dtype=object)
@@ -145,11 +145,11 @@ def export_modes_vtu(model: FEModel, modes: ModeSet, filename, indices=None) -> 
                   for g, name in enumerate(names)})
     with atomic_path(filename) as tmp:
         meshio.write(tmp, mesh, file_format="vtu")
-        _add_field_data(tmp, field)
+        add_field_data(tmp, field)
     return Path(filename)
 
 
-def _add_field_data(path: Path, field: dict) -> None:
+def add_field_data(path: Path, field: dict) -> None:
     """Insert a ``<FieldData>`` block of ascii arrays into a VTK XML UnstructuredGrid file."""
     tree = ET.parse(path)
     grid = tree.getroot().find("UnstructuredGrid")

@@ -40,7 +40,7 @@ import warnings
 from pathlib import Path
 
 from femmech.errors import FemmechWarning, FileFormatError
-from femmech.reduction.superelement_archive import read_regular
+from femmech.reduction.superelement_file import read_regular
 
 try:  # POSIX; elsewhere runs are judged by their pid and age
     import fcntl

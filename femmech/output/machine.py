@@ -19,13 +19,13 @@ from pathlib import Path
 import numpy as np
 
 from femmech.analysis.modes import ModeSet
-from femmech.coupling import CoupledSystem, _weights
+from femmech.coupling import CoupledSystem, direction_weights
 from femmech.fe.dofs import DOF_PER_NODE
 from femmech.fe.model import FEModel, node_index
 from femmech.output.annotate import LegendEntry
 from femmech.output.charts import format_speed
 from femmech.output.mode_geometry import SCALE_FRACTION, marker_size, model_size
-from femmech.output.plot import _plot
+from femmech.output.plot import plot
 from femmech.output.renderer import Decoration
 from femmech.reduction.superelement import Superelement
 
@@ -111,7 +111,7 @@ def plot_coupled_mode(model: FEModel, system: CoupledSystem, x: np.ndarray, freq
         kwargs.setdefault("reach", SCALE_FRACTION * model_size(model))
     kwargs.setdefault("mode_type", False)
     decoration = mechanism_decoration(glyphs, model_size(model), marker_size(model))
-    return _plot(model, modes, [0], [Path(filename)], workers=1, decorate=decoration,
+    return plot(model, modes, [0], [Path(filename)], workers=1, decorate=decoration,
                  title=coupled_title(freq_hz, angle, speed, mode_number, speed_unit), **kwargs)[0]
 
 
@@ -146,7 +146,7 @@ def _mechanism_glyphs(model, system, x, u):
     for mount, P, idx in zip(system.mounts, system.projections, system.touched, strict=True):
         q = P @ np.real(x[idx])
         for att in mount.attachments:
-            w = _weights(att.direction)[:3]
+            w = direction_weights(att.direction)[:3]
             if not np.any(w):
                 continue
             node = att.node if isinstance(att.node, (int, np.integer)) else \

@@ -42,7 +42,7 @@ from femmech.output.annotate import (
     scale_text,
 )
 from femmech.output.camera import Camera, camera_from_position, check_view, fit_camera, screen_axes
-from femmech.output.export import _check_sizes, _mode_indices, atomic_path
+from femmech.output.export import atomic_path, check_sizes, mode_indices
 from femmech.output.mode_geometry import (  # noqa: F401 (re-exported: the drawing's numbers)
     MASS_RADIUS_FRACTION,
     RADIUS_RANGE,
@@ -149,7 +149,7 @@ def plot_mode(model: FEModel, modes: ModeSet, index: int, filename, scale: float
     Path
         ``filename``.
     """
-    return _plot(model, modes, [index], [Path(filename)], workers=1, scale=scale,
+    return plot(model, modes, [index], [Path(filename)], workers=1, scale=scale,
                  window_size=window_size, camera=camera, n_sub=n_sub,
                  show_undeformed=show_undeformed, masses=masses, title=title,
                  decorate=decorate, mode_type=mode_type)[0]
@@ -191,12 +191,12 @@ def plot_modes(model: FEModel, modes: ModeSet, out_dir, indices=None, prefix: st
     out = Path(out_dir)
     if not out.is_dir():
         raise FileNotFoundError(f"output folder {out} does not exist")
-    idx = [int(i) for i in _mode_indices(modes, indices)]
+    idx = [int(i) for i in mode_indices(modes, indices)]
     files = [out / f"{prefix}_{i + 1:02d}.png" for i in idx]
-    return _plot(model, modes, idx, files, workers=workers, progress=progress, **kwargs)
+    return plot(model, modes, idx, files, workers=workers, progress=progress, **kwargs)
 
 
-def _plot(model, modes, indices, files, workers, scale=None, window_size=(1024, 768),
+def plot(model, modes, indices, files, workers, scale=None, window_size=(1024, 768),
           camera=None, n_sub=8, show_undeformed=True, masses=None, title=None, decorate=None,
           mode_type=None, progress=None, scale_note: bool | None = None,
           reach: float | None = None) -> list[Path]:
@@ -207,9 +207,9 @@ def _plot(model, modes, indices, files, workers, scale=None, window_size=(1024, 
     ``reach`` (m): fit the camera to the undeformed drawing with every point moved by up
     to this much in any direction, instead of to the drawn modes, so that every image of
     the model gets the same camera whatever mode it shows (images drawn one per call)."""
-    _check_sizes(model, modes)
+    check_sizes(model, modes)
     check_view(camera)
-    indices = [int(i) for i in _mode_indices(modes, indices)]
+    indices = [int(i) for i in mode_indices(modes, indices)]
     if decorate is not None and not isinstance(decorate, Decoration):
         decorate = Decoration(decorate)
     mass_nodes = None if masses is None else [node_index(model.mesh, m.node, "point mass")

@@ -44,7 +44,7 @@ from femmech.analysis.modes import ModeSet
 from femmech.coupling import CoupledSystem
 from femmech.fe.dofs import DOF_PER_NODE
 from femmech.fe.model import FEModel
-from femmech.output.export import _add_field_data, _check_sizes, _mode_indices, atomic_path
+from femmech.output.export import add_field_data, atomic_path, check_sizes, mode_indices
 from femmech.output.machine import frame_shape
 from femmech.output.surfaces import cell_blocks
 
@@ -68,8 +68,8 @@ def write_mode_series(model: FEModel, modes: ModeSet, filename, indices=None) ->
     -------
     Path
     """
-    _check_sizes(model, modes)
-    idx = _mode_indices(modes, indices)
+    check_sizes(model, modes)
+    idx = mode_indices(modes, indices)
     steps = [(float(i + 1), _nodal(modes.shapes[:, i]),
               {"frequency_hz": float(modes.freq_hz[i])}) for i in idx]
     return _write(model, steps, filename, "mode number")
@@ -198,7 +198,7 @@ def _write_pvd(points, blocks, steps, target: Path, time_label: str) -> None:
             name = f"step_{k:05d}.vtu"
             meshio.write(staging / name, meshio.Mesh(points, blocks, point_data=fields),
                          file_format="vtu")
-            _add_field_data(staging / name, {key: ("Float64", np.array([value]))
+            add_field_data(staging / name, {key: ("Float64", np.array([value]))
                                              for key, value in meta.items()})
             ET.SubElement(collection, "DataSet", timestep=repr(time), group="", part="0",
                           file=f"{folder.name}/{name}")

@@ -8,10 +8,10 @@
   superelement's modes and of coupled quasi-modes over a sweep;
 * :mod:`.interface_modes`: Craig-Bampton with a reduced interface (mode traces,
   attachment vectors, characteristic constraint modes) and its error estimate;
-* :mod:`.superelement_file`: the validated file format (writer and reader), with
-  :mod:`.superelement_format` (fields, checksums, messages), :mod:`.superelement_archive`
-  (zip members and ``.npy`` headers) and :mod:`.superelement_checks` (meta, shapes,
-  values);
+* :mod:`.superelement_file`: the validated file format in one module (fields, checksums,
+  the writer, the reader and its checks of zip members, ``.npy`` headers, meta, shapes
+  and values; :mod:`.superelement_format`, :mod:`.superelement_archive` and
+  :mod:`.superelement_checks` are old paths of its parts);
 * :mod:`.substructures`: the assembly of several superelements and plain FE parts into
   one system.
 

@@ -130,7 +130,7 @@ def craig_bampton(model: FEModel, interface, n_modes: int | None = None,
                    residual_vectors=residual_vectors)
 
 
-def _partition(model: FEModel, interface):
+def partition(model: FEModel, interface):
     """(interface DOFs in the full model, their positions b among the free DOFs, the
     interior positions, K_free and M_free as CSR); ValueError if nothing is interior."""
     dofs = interface_dofs(model, interface)
@@ -141,7 +141,7 @@ def _partition(model: FEModel, interface):
     return dofs, b, interior, model.K_free.tocsr(), model.M_free.tocsr()
 
 
-def _interior_blocks(K, M, interior, b):
+def interior_blocks(K, M, interior, b):
     """(K_ii, K_ib, M_ii, M_ib) as CSR, the interior rows sliced once (each slice of rows
     is a copy of the model's size)."""
     Ki, Mi = K[interior], M[interior]
@@ -150,25 +150,25 @@ def _interior_blocks(K, M, interior, b):
 
 def _reduce(model: FEModel, interface, selection, method: str,
             residual_vectors: bool = False, low_memory: bool | None = None) -> Superelement:
-    dofs, b, interior, K, M = _partition(model, interface)
-    Kii, Kib, Mii, Mib = _interior_blocks(K, M, interior, b)
+    dofs, b, interior, K, M = partition(model, interface)
+    Kii, Kib, Mii, Mib = interior_blocks(K, M, interior, b)
     timings = {}
     t0 = time.perf_counter()
-    lu = _factorize_interior(Kii, model.free[interior])
+    lu = factorize_interior(Kii, model.free[interior])
     t1 = time.perf_counter()
     Psi = rows_contiguous(lu.solve(Kib.toarray(order="F")), scale=-1.0)
     t2 = time.perf_counter()
     if low_memory is None:
         low_memory = interior.size >= LOW_MEMORY_DOFS and selection is not None \
             and selection[0] == "count" and selection[1] > 0
-    omega2, Phi = _fixed_interface_modes(Kii, Mii, selection, lu, check=not low_memory)
+    omega2, Phi = fixed_interface_modes(Kii, Mii, selection, lu, check=not low_memory)
     n_fixed = omega2.size
     n_residual = 0
     response = None
     with product_phase(Psi.shape[0], Psi.shape[1] + Phi.shape[1]):
         if residual_vectors:
             keep = not low_memory and 8 * Psi.size <= KEEP_RESPONSE_BYTES
-            more_omega2, more_Phi, response = _residual_vectors(Kii, Mii, Mib, Psi, Phi, lu,
+            more_omega2, more_Phi, response = residual_modes(Kii, Mii, Mib, Psi, Phi, lu,
                                                                 keep)
             omega2, Phi = np.concatenate([omega2, more_omega2]), np.hstack([Phi, more_Phi])
             n_residual = more_omega2.size
@@ -188,7 +188,7 @@ def _reduce(model: FEModel, interface, selection, method: str,
                         model.T.tocsr(), timings, n_residual, lu, inertia_response=response)
 
 
-def _factorize_interior(Kii, dofs):
+def factorize_interior(Kii, dofs):
     """LU of ``K_ii``; ValueError naming a DOF of a zero pivot if K_ii is singular.
 
     SuperLU rarely stops on a singular symmetric matrix: the zero pivot of an unrestrained
@@ -210,7 +210,7 @@ def _factorize_interior(Kii, dofs):
     return lu
 
 
-def _fixed_interface_modes(Kii, Mii, selection, lu, check: bool = True):
+def fixed_interface_modes(Kii, Mii, selection, lu, check: bool = True):
     """(ω², Φ) of the fixed-interface modes, with ``lu`` (K_ii) as the shift factor;
     ``check=False`` leaves the Sturm check of a mode count to the caller."""
     n_i = Kii.shape[0]
@@ -227,7 +227,7 @@ def _fixed_interface_modes(Kii, Mii, selection, lu, check: bool = True):
     return result.omega2, result.vectors
 
 
-def _residual_vectors(Kii, Mii, Mib, Psi, Phi, lu, keep: bool = False):
+def residual_modes(Kii, Mii, Mib, Psi, Phi, lu, keep: bool = False):
     """Residual vectors, as K- and M-orthogonal pseudo-modes: (ω², vectors (n_i, <= n_b),
     ``K_ii⁻¹ (M_ii Ψ + M_ib)`` (n_i, n_b) if ``keep`` else None).
 

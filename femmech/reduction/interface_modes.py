@@ -66,11 +66,11 @@ from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE
 from femmech.fe.model import FEModel, node_indices
 from femmech.reduction.component_modes import (
     CUTOFF_FACTOR,
-    _factorize_interior,
-    _fixed_interface_modes,
-    _interior_blocks,
-    _partition,
-    _residual_vectors,
+    factorize_interior,
+    fixed_interface_modes,
+    interior_blocks,
+    partition,
+    residual_modes,
 )
 from femmech.reduction.products import rows_contiguous
 from femmech.reduction.superelement import Superelement
@@ -164,9 +164,9 @@ def reduce_interface(model: FEModel, interface, n_modes: int | None = None,
     """
     selection, f_max = _selection(n_modes, cutoff_hz, f_max_hz)
     t0 = time.perf_counter()
-    dofs, b, interior, K, M = _partition(model, interface)
-    Kii, Kib, Mii, Mib = _interior_blocks(K, M, interior, b)
-    lu = _factorize_interior(Kii, model.free[interior])
+    dofs, b, interior, K, M = partition(model, interface)
+    Kii, Kib, Mii, Mib = interior_blocks(K, M, interior, b)
+    lu = factorize_interior(Kii, model.free[interior])
     sigma = default_shift(K, M)
     full = factorize((K - sigma * M).tocsc())
     t1 = time.perf_counter()
@@ -184,13 +184,13 @@ def reduce_interface(model: FEModel, interface, n_modes: int | None = None,
         W = _join(K, M, W, traces, b, interior, Kib, lu)
     V = np.ascontiguousarray(W[b])
     t2 = time.perf_counter()
-    omega2, Phi = _fixed_interface_modes(Kii, Mii, selection, lu)
+    omega2, Phi = fixed_interface_modes(Kii, Mii, selection, lu)
     Psi = rows_contiguous(W[interior])
     n_residual = 0
     with _phase(Psi.shape[1] + Phi.shape[1]):
         if residual_vectors:
             MibV = (Mib @ sp.csr_matrix(V)).tocsr()  # rows next to b only
-            more_omega2, more_Phi, _ = _residual_vectors(Kii, Mii, MibV, Psi, Phi, lu)
+            more_omega2, more_Phi, _ = residual_modes(Kii, Mii, MibV, Psi, Phi, lu)
             omega2, Phi = np.concatenate([omega2, more_omega2]), np.hstack([Phi, more_Phi])
             n_residual = more_omega2.size
         t3 = time.perf_counter()

@@ -1,6 +1,6 @@
 """Old path of the reduction (previous layout), now :mod:`femmech.reduction.superelement`,
 :mod:`femmech.reduction.component_modes`, :mod:`femmech.reduction.products`,
-:mod:`femmech.reduction.estimate` and :mod:`femmech.reduction.superelement_format`.
+:mod:`femmech.reduction.estimate` and :mod:`femmech.reduction.superelement_file`.
 
 Every public name it had works here with a DeprecationWarning naming its new place
 (docs/architecture.md, "Moved names"); nothing inside femmech imports this module.
@@ -13,7 +13,7 @@ def __getattr__(name: str):
 
     return moved(__name__, name, {
         "CUTOFF_FACTOR": "femmech.reduction.component_modes.CUTOFF_FACTOR",
-        "FORMAT_VERSION": "femmech.reduction.superelement_format.FORMAT_VERSION",
+        "FORMAT_VERSION": "femmech.reduction.superelement_file.FORMAT_VERSION",
         "PIVOT_RTOL": "femmech.reduction.component_modes.PIVOT_RTOL",
         "SYMMETRIC_BLOCK": "femmech.reduction.products.SYMMETRIC_BLOCK",
         "Superelement": "femmech.reduction.superelement.Superelement",

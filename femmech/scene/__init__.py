@@ -7,7 +7,10 @@ mounts (:mod:`.machine`) and analyses (:mod:`.analyses`) → the validated
 → meshes, FE models, superelements and mounts with every reference checked
 (:mod:`.build`) → cached reductions (:mod:`.cache`) → lazily built objects of one run
 (:mod:`.workshop`) → the analyses' files and report sections (:mod:`.tasks`) → the run
-into one output folder (:mod:`.run`).
+into one output folder (:mod:`.run`). Beside them: generated meshes sized for a band
+(:mod:`.auto_mesh`), the memory a part needs before it is built (:mod:`.memory`), the
+cache's folder (:mod:`.cache_folder`), the chain tables (:mod:`.chain`) and the report
+sections describing a run (:mod:`.summary`).
 
 Sits on top: may import every lower stage, nothing imports it but :mod:`femmech.cli`.
 """

@@ -44,14 +44,14 @@ from filelock import FileLock, Timeout
 from femmech.errors import CacheWarning
 from femmech.output.export import atomic_path
 from femmech.reduction.superelement import FORMAT_VERSION, Superelement
-from femmech.reduction.superelement_archive import open_regular, read_regular
+from femmech.reduction.superelement_file import open_regular, read_regular
 from femmech.scene.cache_folder import (
-    _evict,
-    _remove,
-    _size,
     cache_max_bytes,
     entry_paths,
+    evict,
+    format_size,
     lock_path,
+    remove,
     remove_stale_temporaries,
 )
 
@@ -93,7 +93,7 @@ MAX_MANIFEST = 1 << 20
 """Largest manifest read, bytes (a manifest holds a few hundred)."""
 
 
-def _sha256_file(path: Path, size: int | None = None) -> str:
+def sha256_file(path: Path, size: int | None = None) -> str:
     """SHA-256 hex of the cache entry ``path``, a regular file (not a link to one) of
     ``size`` bytes if given (else FileFormatError naming the sizes). A FIFO, a device, a
     directory or a link in its place: FileFormatError (:func:`open_regular`)."""
@@ -136,7 +136,7 @@ def read_entry(folder, key: str) -> tuple[Superelement | None, str | None]:
         if not isinstance(size, int) or isinstance(size, bool):
             return None, f"unreadable manifest (size {size!r}, expected bytes)"
         try:
-            digest = _sha256_file(data_path, size)
+            digest = sha256_file(data_path, size)
         except FileNotFoundError:
             return None, "superelement file missing"
         except _SizeMismatchError as exc:
@@ -169,12 +169,12 @@ def write_entry(folder, key: str, se: Superelement, label: str) -> Path:
         manifest_path.unlink(missing_ok=True)  # an old manifest must not vouch for new data
         se.save(data_path)
         manifest = {"key": key, "label": label, "file": data_path.name,
-                    "size": data_path.stat().st_size, "sha256": _sha256_file(data_path),
+                    "size": data_path.stat().st_size, "sha256": sha256_file(data_path),
                     "format": FORMAT_VERSION, "created": time.strftime("%Y-%m-%dT%H:%M:%S")}
         with atomic_path(manifest_path) as tmp:
             tmp.write_text(json.dumps(manifest, indent=1), encoding="utf-8")
     except BaseException:
-        _remove(manifest_path, data_path)
+        remove(manifest_path, data_path)
         raise
     return data_path
 
@@ -218,14 +218,14 @@ def cached_reduction(folder, key: str, label: str, build: Callable[[], Superelem
             stored = state in ("held", "unlocked") and _store(folder, key, se, label, problems)
             status = ("corrupt" if rejected else "miss") if stored else "unstored"
             if stored:
-                evicted = _evict(folder, limit, key)
+                evicted = evict(folder, limit, key)
     seconds = time.perf_counter() - start
     head, action, outcome = _WORDS[status]
     detail = f": {'; '.join(problems)};" if problems else ","
     log(f"{head}: {label} ({short}){detail} {action} in {seconds:.2f} s")
     if evicted[0]:
-        log(f"cache evicted: {evicted[0]} least recently used entries ({_size(evicted[1])})"
-            f" to stay within {_size(limit)}")
+        log(f"cache evicted: {evicted[0]} least recently used entries ({format_size(evicted[1])})"
+            f" to stay within {format_size(limit)}")
     if problems:
         warnings.warn(f"reduction cache {folder}: entry {short} ({label}):"
                       f" {'; '.join(problems)}; {outcome}", CacheWarning, stacklevel=2)

@@ -129,7 +129,7 @@ def lock_path(folder, key: str) -> Path:
     return Path(folder) / f"{key}.lock"
 
 
-def _remove(*paths: Path) -> int:
+def remove(*paths: Path) -> int:
     """Unlink the files that exist; the number removed (errors ignored)."""
     count = 0
     for path in paths:
@@ -209,11 +209,11 @@ def remove_stale_temporaries(folder) -> int:
     """Remove the temporary files of killed runs (see :func:`_is_stale`); the number
     removed. Temporaries of a write in progress in another process are kept."""
     folder = Path(folder)
-    return sum(_remove(path) for key, path, stat in _scan(folder)["temporary"]
+    return sum(remove(path) for key, path, stat in _scan(folder)["temporary"]
                if _is_stale(folder, key, stat))
 
 
-def _evict(folder: Path, limit: int, keep: str) -> tuple[int, int]:
+def evict(folder: Path, limit: int, keep: str) -> tuple[int, int]:
     """Remove least recently used entries (not ``keep``, not locked by another process)
     until the entries total at most ``limit`` bytes; (entries removed, bytes freed)."""
     entries = _entries(_scan(folder))
@@ -227,7 +227,7 @@ def _evict(folder: Path, limit: int, keep: str) -> tuple[int, int]:
         paths = entry_paths(folder, key)[::-1]  # the manifest first
         with _if_free(folder, key) as free:
             if free:
-                _remove(*paths)
+                remove(*paths)
         if free and not any(path.exists() for path in paths):
             count, freed = count + 1, freed + size
     return count, freed
@@ -254,8 +254,8 @@ def format_cache_info(info: CacheInfo) -> str:
 
     lines = [f"reduction cache {info.folder}",
              f"  {info.entries} {'entry' if info.entries == 1 else 'entries'},"
-             f" {_size(info.total_bytes)} of"
-             f" {_size(info.max_bytes)} (limit; ${MAX_BYTES_ENV})"]
+             f" {format_size(info.total_bytes)} of"
+             f" {format_size(info.max_bytes)} (limit; ${MAX_BYTES_ENV})"]
     if info.oldest_use is not None:
         lines.append(f"  last used: oldest {when(info.oldest_use)}, newest"
                      f" {when(info.newest_use)}")
@@ -291,7 +291,7 @@ def clear_cache(folder) -> int:
     return count
 
 
-def _size(n: float) -> str:
+def format_size(n: float) -> str:
     """Bytes in binary units: ``'1.5 MiB'``."""
     for unit in ("B", "KiB", "MiB"):
         if n < 1024:

@@ -15,7 +15,8 @@ surface mesh, ``n^(4/3)`` for a solid or a three-dimensional grid of joints, ``n
 line-like frame (members between a few joints add little fill), each block 6 x 6 values.
 Eigenvectors and solver workspace come on top.
 
-Stage 8 (scene), reading and building: imports nothing of femmech.
+Stage 8 (scene), reading and building: imports only :mod:`femmech.fe.dofs` (the DOFs
+per node).
 """
 
 from __future__ import annotations
@@ -23,13 +24,14 @@ from __future__ import annotations
 import math
 import os
 
+from femmech.fe.dofs import DOF_PER_NODE
+
 MEMORY_ENV = "FEMMECH_MEMORY_LIMIT_GB"
 """Environment variable that sets the memory limit (GB = 1e9 bytes) instead of
 :data:`MEMORY_FRACTION` of the available memory."""
 MEMORY_FRACTION = 0.9
 """Share of the available memory (``MemAvailable``, else the physical memory) a part may
 be estimated to need."""
-DOF_PER_NODE = 6
 _VALUE = 8  # bytes of a float64
 _ENTRY = 12  # bytes of a CSR entry: float64 value + int32 index
 

@@ -16,7 +16,7 @@ from femmech.solve import threads
 from femmech.solve.pencil import _n_mass
 
 
-def _arpack(K, M, k, sigma, lu, deflate=None, maxiter=None):
+def arpack(K, M, k, sigma, lu, deflate=None, maxiter=None):
     """``k`` eigenpairs nearest ``sigma`` by shift-invert Lanczos (ARPACK).
 
     ``deflate`` (n, m), M-orthonormal eigenvectors already found, is projected out of the
@@ -53,12 +53,12 @@ def _arpack(K, M, k, sigma, lu, deflate=None, maxiter=None):
         omega2, X = spla.eigsh(sp.csr_matrix(K), k=k, M=sp.csr_matrix(M), sigma=sigma,
                                which="LM", OPinv=op, v0=v0, ncv=ncv, maxiter=maxiter)
     if krylov + (0 if deflate is None else deflate.shape[1]) < n:
-        X = _purify(X, omega2, sigma, M, solve)
+        X = purify(X, omega2, sigma, M, solve)
     order = np.argsort(omega2)
     return omega2[order], X[:, order]
 
 
-def _purify(X, omega2, sigma, M, solve):
+def purify(X, omega2, sigma, M, solve):
     """One operator step ``x ← (λ - σ) (K - σM)⁻¹ M x`` for a singular M (massless DOFs).
 
     Lanczos vectors are M-orthonormal, and M does not see components in its null space:
@@ -68,3 +68,6 @@ def _purify(X, omega2, sigma, M, solve):
     "How to implement the spectral transformation", Math. Comp. 48 (1987) 663-673).
     """
     return solve(M @ X) * (omega2 - sigma)
+
+
+_arpack = arpack  # old name: femmech.solve.eigen imports it

@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from femmech.solve import threads
-from femmech.solve.factor import Factor, _singular, _square
+from femmech.solve.factor import Factor, singular_error, square_matrix
 
 
 class CholmodFactor(Factor):
@@ -26,7 +26,7 @@ class CholmodFactor(Factor):
     def __init__(self, A, definite: bool | None = None, order=None):
         from sksparse import cholmod
         self._cholmod = cholmod
-        A = _square(A)
+        A = square_matrix(A)
         super().__init__(A.shape[0], order)
         self._want = definite
         A = self._in_order(A)
@@ -58,12 +58,12 @@ class CholmodFactor(Factor):
                 self._f.cholesky_inplace(A)
         except self._cholmod.CholmodNotPositiveDefiniteError as exc:
             if self._mode == "simplicial" and self._want is not True:
-                raise _singular(exc) from exc  # an LDLᵀ stops only on a zero pivot
+                raise singular_error(exc) from exc  # an LDLᵀ stops only on a zero pivot
             raise ValueError(f"matrix is not positive definite ({exc})") from exc
         self.timings["factorise"] = time.perf_counter() - start
         d = self._f.D()
         if not np.all(np.isfinite(d)) or not np.all(d != 0):
-            raise _singular("zero or non-finite pivot")
+            raise singular_error("zero or non-finite pivot")
         self._d = d
         self._definite = bool(np.all(d > 0))
         if self._want and not self.definite:

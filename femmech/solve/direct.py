@@ -45,8 +45,8 @@ import os
 
 from femmech.solve import threads
 from femmech.solve.cholmod import CholmodFactor
-from femmech.solve.factor import Factor, _square
-from femmech.solve.pardiso import PardisoFactor, _mkl, mkl_version
+from femmech.solve.factor import Factor, square_matrix
+from femmech.solve.pardiso import PardisoFactor, mkl_library, mkl_version
 from femmech.solve.superlu import SuperLUFactor
 
 BACKENDS = ("superlu", "cholmod", "pardiso")
@@ -81,7 +81,7 @@ def available() -> tuple[str, ...]:
             except ImportError:
                 continue
             found.append(name)
-        elif name == "pardiso" and _mkl() is not None:
+        elif name == "pardiso" and mkl_library() is not None:
             found.append(name)
     return tuple(found)
 
@@ -167,7 +167,7 @@ def factorize(A, solver: str | None = None, definite: bool | None = None,
         With "singular" in the message when A cannot be factorised (exact zero pivot), or
         "not positive definite" with ``definite=True``.
     """
-    A = _square(A)
+    A = square_matrix(A)
     name = resolve(solver, A.shape[0])
     if name == "superlu":
         with threads.factor_phase():

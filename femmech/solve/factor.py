@@ -70,7 +70,7 @@ class Factor:
 
     def _same_order(self, A, what: str):
         """A as a square sparse matrix of this factor's order (ValueError otherwise)."""
-        A = _square(A)
+        A = square_matrix(A)
         if A.shape[0] != self.n:
             raise ValueError(f"{what}: matrix of order {A.shape[0]}, factor of order {self.n}")
         return A
@@ -123,12 +123,12 @@ def _dropped():
     return None
 
 
-def _square(A, what="A"):
+def square_matrix(A, what="A"):
     A = A if sp.issparse(A) else sp.csc_matrix(np.asarray(A, dtype=float))
     if A.ndim != 2 or A.shape[0] != A.shape[1]:
         raise ValueError(f"{what} must be a square matrix, got shape {A.shape}")
     return A
 
 
-def _singular(exc) -> ValueError:
+def singular_error(exc) -> ValueError:
     return ValueError(f"matrix is singular and cannot be factorised ({exc})")

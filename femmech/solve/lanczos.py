@@ -1,11 +1,11 @@
 """Shift-invert block Lanczos for the eigenpairs of ``K x = λ M x`` nearest a shift σ.
 
-:func:`_lowest_pairs` runs femmech's block Lanczos (:func:`_block_lanczos`, with partial
+:func:`lowest_pairs` runs femmech's block Lanczos (:func:`block_lanczos`, with partial
 reorthogonalisation and thick restarts; its steps are the methods of
 :class:`_BlockLanczos`) and falls back to ARPACK (:mod:`.arpack`) where it does not
 converge; the constants below set its tolerances, block size, reorthogonalisation and
 memory. It also tells the caller when σ lies far below the wanted eigenvalues
-(:class:`_FarShiftError`).
+(:class:`FarShiftError`).
 
 Stage 1, solve (linear algebra): imports only :mod:`femmech.errors` and other
 :mod:`femmech.solve` modules, never :mod:`femmech.fe` or higher.
@@ -21,24 +21,24 @@ import scipy.sparse as sp
 
 from femmech.errors import FemmechWarning
 from femmech.solve import threads
-from femmech.solve.arpack import _arpack, _purify
+from femmech.solve.arpack import arpack, purify
 from femmech.solve.pencil import _n_mass
-from femmech.solve.sturm import _complete_cluster
+from femmech.solve.sturm import complete_cluster
 
 LANCZOS_TOL = 1e-12
-"""Convergence of :func:`_block_lanczos`: ``‖S x - θ x‖_M <= LANCZOS_TOL |θ|`` for every
+"""Convergence of :func:`block_lanczos`: ``‖S x - θ x‖_M <= LANCZOS_TOL |θ|`` for every
 wanted Ritz pair of ``S = (K - σM)⁻¹ M``. Eigenvalue errors go like the square of this
 (measured 5e-15 relative on 24k and 151k-DOF frames against ARPACK at machine
 precision); the relative residuals ``‖K x - λ M x‖ / (λ ‖M x‖)`` come out 10-300 times
 larger (they weigh the stiff directions): 1e-10 to 6e-10 on those frames."""
 
 GUARD_TOL = 1e-6
-"""Convergence of the guard pairs of :func:`_block_lanczos` (computed beyond the wanted
+"""Convergence of the guard pairs of :func:`block_lanczos` (computed beyond the wanted
 ones only to see whether the last wanted eigenvalue is repeated): their eigenvalues are
-then accurate to ~1e-12, far below the 1e-6 of a cluster (:func:`~.sturm._complete_cluster`)."""
+then accurate to ~1e-12, far below the 1e-6 of a cluster (:func:`~.sturm.complete_cluster`)."""
 
 BLOCK_SIZE = 2
-"""Block size of :func:`_block_lanczos`. b >= 2 finds both members of a double
+"""Block size of :func:`block_lanczos`. b >= 2 finds both members of a double
 eigenvalue (symmetric structures) in one run, where single-vector Lanczos finds the
 second only late, from round-off (a 24k-DOF frame: a 20-mode run with b = 1 returned
 the 21st eigenvalue 5 % too high). Larger blocks need more vectors for the same modes
@@ -75,9 +75,9 @@ MAX_BASIS_BYTES = 4 * 1024**3
 restart): 268 vectors at 1M DOFs, no restart for 20-40 modes up to ~1M DOFs."""
 
 MAX_SOLVES_PER_MODE = 40
-"""Cap of :func:`_block_lanczos`: after ``MAX_SOLVES_PER_MODE k + 400`` solved vectors
+"""Cap of :func:`block_lanczos`: after ``MAX_SOLVES_PER_MODE k + 400`` solved vectors
 without convergence (normal runs take 3-5 per mode) it gives up and ARPACK takes over
-(:func:`_lowest_pairs`); a safeguard against a basis that restarts without progress."""
+(:func:`lowest_pairs`); a safeguard against a basis that restarts without progress."""
 
 _EPS = float(np.finfo(float).eps)
 
@@ -101,11 +101,11 @@ residuals of 1.5e-6); frames and shells of the benchmarks have -σ / λ_1 = 0.2-
 
 
 class _NotConvergedError(RuntimeError):
-    """:func:`_block_lanczos` reached :data:`MAX_SOLVES_PER_MODE`."""
+    """:func:`block_lanczos` reached :data:`MAX_SOLVES_PER_MODE`."""
 
 
-class _FarShiftError(RuntimeError):
-    """:func:`_block_lanczos` found σ far below the wanted eigenvalues; ``shift`` is a
+class FarShiftError(RuntimeError):
+    """:func:`block_lanczos` found σ far below the wanted eigenvalues; ``shift`` is a
     better one (rad²/s²)."""
 
     def __init__(self, shift: float):
@@ -113,15 +113,15 @@ class _FarShiftError(RuntimeError):
         self.shift = shift
 
 
-def _lowest_pairs(K, M, k, sigma, lu, deflate=None, n_wanted=None, far_check=False):
+def lowest_pairs(K, M, k, sigma, lu, deflate=None, n_wanted=None, far_check=False):
     """``k`` eigenpairs nearest σ: block Lanczos, ARPACK where it does not converge.
-    ``far_check``: raise :class:`_FarShiftError` where σ is too far (:data:`FAR_SHIFT`)."""
+    ``far_check``: raise :class:`FarShiftError` where σ is too far (:data:`FAR_SHIFT`)."""
     try:
-        return _block_lanczos(K, M, k, sigma, lu, deflate=deflate, n_wanted=n_wanted,
+        return block_lanczos(K, M, k, sigma, lu, deflate=deflate, n_wanted=n_wanted,
                               far_check=far_check)
     except _NotConvergedError as exc:
         warnings.warn(f"{exc}; falling back to ARPACK", FemmechWarning, stacklevel=3)
-        return _arpack(K, M, k, sigma, lu, deflate=deflate)
+        return arpack(K, M, k, sigma, lu, deflate=deflate)
 
 
 def _streaming(columns: int):
@@ -129,7 +129,7 @@ def _streaming(columns: int):
     return threads.gemm_phase() if columns >= STREAM_COLUMNS else contextlib.nullcontext()
 
 
-def _block_lanczos(K, M, k, sigma, lu, deflate=None, block=BLOCK_SIZE, tol=LANCZOS_TOL,
+def block_lanczos(K, M, k, sigma, lu, deflate=None, block=BLOCK_SIZE, tol=LANCZOS_TOL,
                    max_dim=None, seed=12345, n_wanted=None, partial=True, far_check=False):
     """``k`` eigenpairs nearest ``sigma`` by block Lanczos on ``S = (K - σM)⁻¹ M``.
 
@@ -146,7 +146,7 @@ def _block_lanczos(K, M, k, sigma, lu, deflate=None, block=BLOCK_SIZE, tol=LANCZ
     (as with ``partial=False``, and after a block lost rank). The start block is ``S R``
     for a random R, so every basis vector lies in the range of S (no components that M
     does not see). ``deflate`` (n, m): M-orthonormal eigenvectors projected out of the
-    operator, as in :func:`~.arpack._arpack`.
+    operator, as in :func:`~.arpack.arpack`.
 
     ``n_wanted``: only the ``n_wanted`` pairs nearest σ (and the rest of a cluster cut at
     the last of them) must reach ``tol``; the others of the k, guards that show whether the
@@ -168,7 +168,7 @@ def _block_lanczos(K, M, k, sigma, lu, deflate=None, block=BLOCK_SIZE, tol=LANCZ
 
 
 class _BlockLanczos:
-    """State of one run of :func:`_block_lanczos`: the basis V, MV, the projected operator
+    """State of one run of :func:`block_lanczos`: the basis V, MV, the projected operator
     H, the orthogonality estimates of partial reorthogonalisation and the random probes."""
 
     def __init__(self, K, M, k, sigma, lu, deflate, block, tol, max_dim, seed, n_wanted):
@@ -300,7 +300,7 @@ class _BlockLanczos:
         if len(theta) < k:
             return False
         lam = np.sort(self.sigma + 1.0 / theta[:k])
-        tight = _complete_cluster(lam, self.n_wanted) if self.n_wanted < k else k
+        tight = complete_cluster(lam, self.n_wanted) if self.n_wanted < k else k
         limit = np.where(np.arange(k) < tight, tol, max(tol, GUARD_TOL))
         return bool(np.all(est[:k] <= limit * np.abs(theta[:k])))
 
@@ -316,7 +316,7 @@ class _BlockLanczos:
 
     def iterate(self, partial, far_check):
         """The Lanczos loop: block steps until the Ritz pairs converge. ``partial`` and
-        ``far_check`` as in :func:`_block_lanczos`. Returns the Ritz values θ (nearest σ
+        ``far_check`` as in :func:`block_lanczos`. Returns the Ritz values θ (nearest σ
         first), their coefficients Y in the basis and the basis size m."""
         block, krylov, k, H = self.block, self.krylov, self.k, self.H
         with threads.solve_phase():  # a loop of solves and thin products: 1 BLAS thread
@@ -464,13 +464,13 @@ class _BlockLanczos:
         return theta, Y, est
 
     def check_shift(self, theta):
-        """:class:`_FarShiftError` where σ is far below the wanted eigenvalues
+        """:class:`FarShiftError` where σ is far below the wanted eigenvalues
         (:data:`FAR_SHIFT`)."""
         sigma = self.sigma
         lam = sigma + 1.0 / theta[:self.k]
         low = lam.min()  # no rigid-body modes (|λ| ~ 0) and no negative ones
         if sigma < 0 and low > 1e-6 * -sigma and -sigma > FAR_SHIFT * low:
-            raise _FarShiftError(-max(low, 1e-3 * -sigma))
+            raise FarShiftError(-max(low, 1e-3 * -sigma))
 
     def widen(self, Q, MQ, m, b):
         """The b < block directions Q completed by fresh random ones (the Krylov space is
@@ -514,5 +514,9 @@ class _BlockLanczos:
         if self.n_defl:
             X = self.project(X)
         if self.krylov + self.n_defl < self.n:
-            X = _purify(X, omega2, sigma, self.M, self.operator)
+            X = purify(X, omega2, sigma, self.M, self.operator)
         return omega2, X
+
+
+_FarShiftError = FarShiftError  # old name: femmech.solve.eigen imports it
+_lowest_pairs = lowest_pairs  # old name: femmech.solve.eigen imports it

@@ -18,8 +18,10 @@ residuals only (:attr:`femmech.solve.eigen.EigenResult.sturm_count` is None). LO
 the lowest eigenvalues from a random start in practice, but a mode can in principle be
 missed; use shift-invert (:func:`femmech.solve.eigen.solve_symmetric`) where memory allows.
 
-Stage 1, solve (linear algebra): imports only :mod:`femmech.errors` and other
-:mod:`femmech.solve` modules, never :mod:`femmech.fe` or higher.
+Stage 1, solve (linear algebra): sees sparse matrices and arrays only (the node
+coordinates and component of each DOF); the rigid-body modes of an FE model are
+:func:`femmech.fe.nullspace.near_nullspace`. Imports only :mod:`femmech.errors` and
+other :mod:`femmech.solve` modules, never :mod:`femmech.fe` or higher.
 """
 
 from __future__ import annotations
@@ -35,21 +37,19 @@ from femmech.solve.eigen import EigenResult
 from femmech.solve.pencil import eigenvalue_scale
 from femmech.solve.residuals import normalize_modes, residuals
 
-DOF_PER_NODE = 6
 
-
-def rigid_body_modes(points: np.ndarray, dofs: np.ndarray, center=None) -> np.ndarray:
-    """Rigid-body motions on the given DOFs, (n_dofs, 6): ux, uy, uz, rx, ry, rz.
+def rigid_body_vectors(x: np.ndarray, component: np.ndarray, center=None) -> np.ndarray:
+    """Rigid-body motions on a set of DOFs, (n_dofs, 6): ux, uy, uz, rx, ry, rz.
 
     Parameters
     ----------
-    points : ndarray (n_nodes, 3)
-        Node coordinates, m.
-    dofs : ndarray (n_dofs,) of int
-        Global DOF indices ``6 * node + component`` (components ux, uy, uz, rx, ry, rz).
+    x : ndarray (n_dofs, 3)
+        Coordinates of each DOF's node, m.
+    component : ndarray (n_dofs,) of int
+        Each DOF's component: 0, 1, 2 translations ux, uy, uz; 3, 4, 5 rotations rx, ry, rz.
     center : array_like (3,), optional
-        Centre of the rotations, m; default: centroid of the DOFs' nodes (keeps the
-        columns well conditioned).
+        Centre of the rotations, m; default: centroid of ``x`` (keeps the columns well
+        conditioned).
 
     Returns
     -------
@@ -57,16 +57,11 @@ def rigid_body_modes(points: np.ndarray, dofs: np.ndarray, center=None) -> np.nd
         Column k is a unit translation (k < 3) or a unit rotation (rad) about axis k - 3:
         translation DOFs get ``θ × (x - c)``, rotation DOFs get θ.
     """
-    points = np.asarray(points, dtype=float)
-    dofs = np.asarray(dofs, dtype=int)
-    node, comp = np.divmod(dofs, DOF_PER_NODE)
-    if dofs.size and (node.min() < 0 or node.max() >= len(points)):
-        raise ValueError(f"DOF {int(dofs[(node < 0) | (node >= len(points))][0])} refers to"
-                         f" a node outside the {len(points)} points")
-    x = points[node]
+    x = np.asarray(x, dtype=float)
+    comp = np.asarray(component, dtype=int)
     c = x.mean(axis=0) if center is None else np.asarray(center, dtype=float)
     r = x - c
-    B = np.zeros((dofs.size, 6))
+    B = np.zeros((comp.size, 6))
     trans = comp < 3
     B[trans, comp[trans]] = 1.0
     for axis in range(3):
@@ -78,24 +73,22 @@ def rigid_body_modes(points: np.ndarray, dofs: np.ndarray, center=None) -> np.nd
     return B
 
 
-def near_nullspace(model) -> np.ndarray:
-    """Rigid-body modes of an FE model on its free DOFs, (n_free, 6)."""
-    return rigid_body_modes(model.mesh.points, model.free)
+def node_blocks(node: np.ndarray, component: np.ndarray) -> int:
+    """6 or 3 if the DOFs come in complete node blocks of that size, else 1.
 
-
-def node_blocksize(dofs: np.ndarray) -> int:
-    """6 or 3 if the DOFs come in complete consecutive node blocks of that size, else 1.
-
-    Aggregating whole nodes (pyamg on a BSR matrix) keeps the components of a node
-    together; constraints that remove single components leave scalar aggregation.
+    ``node`` and ``component`` (n_dofs,) give each DOF's node and component (0..5); a
+    block is ``size`` consecutive DOFs of one node with consecutive components (a
+    beam/shell node has 6, a solid node 3). Aggregating whole nodes (pyamg on a BSR
+    matrix) keeps the components of a node together; constraints that remove single
+    components leave scalar aggregation.
     """
-    dofs = np.asarray(dofs, dtype=int)
-    for size in (DOF_PER_NODE, 3):
-        if dofs.size % size:
+    node = np.asarray(node, dtype=int)
+    comp = np.asarray(component, dtype=int)
+    for size in (6, 3):
+        if node.size % size:
             continue
-        blocks = dofs.reshape(-1, size)
-        node = blocks // DOF_PER_NODE
-        if np.all(node == node[:, :1]) and np.all(np.diff(blocks, axis=1) == 1):
+        same = node.reshape(-1, size)
+        if np.all(same == same[:, :1]) and np.all(np.diff(comp.reshape(-1, size), axis=1) == 1):
             return size
     return 1
 
@@ -109,7 +102,7 @@ def amg_preconditioner(A, B: np.ndarray | None = None, blocksize: int = 1):
     B : ndarray (n, m), optional
         Near-nullspace (rigid-body modes); default: constant vector.
     blocksize : int
-        DOFs per node for block aggregation (see :func:`node_blocksize`).
+        DOFs per node for block aggregation (see :func:`node_blocks`).
 
     Returns
     -------
@@ -137,9 +130,10 @@ def lobpcg_symmetric(K, M, n_modes: int, B: np.ndarray | None = None, blocksize:
     n_modes : int
         Number of lowest eigenpairs.
     B : ndarray (n, m), optional
-        Near-nullspace of K for the multigrid (:func:`near_nullspace`).
+        Near-nullspace of K for the multigrid (:func:`rigid_body_vectors`; of an FE
+        model: :func:`femmech.fe.nullspace.near_nullspace`).
     blocksize : int
-        DOFs per node for block aggregation (:func:`node_blocksize`).
+        DOFs per node for block aggregation (:func:`node_blocks`).
     rtol : float
         Convergence tolerance of LOBPCG's residual norms ``‖K x / s - μ M x‖`` (``s``:
         :func:`~femmech.solve.pencil.eigenvalue_scale`, ``μ = λ / s``, ``xᵀMx = 1``).
@@ -196,3 +190,16 @@ def lobpcg_symmetric(K, M, n_modes: int, B: np.ndarray | None = None, blocksize:
                       f" {reached:.2e} > rtol = {rtol:.0e}; raise maxiter or use shift-invert",
                       FemmechWarning, stacklevel=2)
     return EigenResult(omega2, X, "lobpcg", sigma, res, None, None, solver="pyamg")
+
+
+def __getattr__(name: str):
+    """Names this module had that read the FE model's DOF numbering, from their new place
+    in stage 2 (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {
+        "DOF_PER_NODE": "femmech.fe.dofs.DOF_PER_NODE",
+        "near_nullspace": "femmech.fe.nullspace.near_nullspace",
+        "node_blocksize": "femmech.fe.nullspace.node_blocksize",
+        "rigid_body_modes": "femmech.fe.nullspace.rigid_body_modes",
+    })

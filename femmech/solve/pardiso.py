@@ -26,7 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from femmech.solve import threads
-from femmech.solve.factor import Factor, _singular, _square
+from femmech.solve.factor import Factor, singular_error, square_matrix
 
 _MKL = None
 
@@ -81,7 +81,7 @@ def _mkl_library_candidates():
         yield found
 
 
-def _mkl():
+def mkl_library():
     """``libmkl_rt`` with ``pardiso`` prototyped (loaded once), or None if not installed."""
     global _MKL
     if _MKL is None:
@@ -111,7 +111,7 @@ def _mkl():
 
 def mkl_version() -> str | None:
     """MKL's version string, or None if MKL is not installed."""
-    lib = _mkl()
+    lib = mkl_library()
     if lib is None:
         return None
     buf = ctypes.create_string_buffer(256)
@@ -130,7 +130,7 @@ _PARDISO_ERRORS = {
 
 def _upper_csr(A):
     """Upper triangle with every diagonal entry stored (PARDISO's symmetric input)."""
-    A = _square(A).tocoo()
+    A = square_matrix(A).tocoo()
     keep = A.row <= A.col
     n = A.shape[0]
     diag = np.arange(n)
@@ -161,7 +161,7 @@ class PardisoFactor(Factor):
     name = "pardiso"
 
     def __init__(self, A, definite: bool | None = None, perm=None):
-        lib = _mkl()
+        lib = mkl_library()
         if lib is None:
             raise ImportError("MKL PARDISO needs the pip package 'mkl' (femmech[fast])")
         self._lib = lib
@@ -232,7 +232,7 @@ class PardisoFactor(Factor):
             if err.value == -4 and self.mtype == 2:
                 raise ValueError(f"matrix is not positive definite (PARDISO error -4: {what})")
             if err.value == -4:
-                raise _singular(f"PARDISO error -4: {what}")
+                raise singular_error(f"PARDISO error -4: {what}")
             raise RuntimeError(f"PARDISO phase {phase} failed with error {err.value}: {what}")
 
     def _numeric(self, a):
@@ -243,7 +243,7 @@ class PardisoFactor(Factor):
             self._call(22, self._a)
         self.timings["factorise"] = time.perf_counter() - start
         if self.iparm[13] > 0:  # perturbed pivots: A is singular to working precision
-            raise _singular(f"PARDISO perturbed {self.iparm[13]} pivots below"
+            raise singular_error(f"PARDISO perturbed {self.iparm[13]} pivots below"
                             f" 1e-{PARDISO_PERTURBATION} of the largest entry")
         self._definite = self.mtype == 2 or self.iparm[22] == 0
 

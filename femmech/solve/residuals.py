@@ -33,11 +33,11 @@ def residuals(K, M, omega2, vectors, floor: float) -> np.ndarray:
 
     ``floor`` (rad²/s², e.g. ``|σ|``) keeps the measure meaningful for rigid-body modes.
     """
-    num, den = _residual_terms(K, M, omega2, vectors, floor)
+    num, den = residual_terms(K, M, omega2, vectors, floor)
     return num / np.where(den > 0, den, 1.0)
 
 
-def _residual_terms(K, M, omega2, vectors, floor: float):
+def residual_terms(K, M, omega2, vectors, floor: float):
     """Numerator ‖K x - λ M x‖ and denominator max(|λ|, floor) ‖M x‖ per column."""
     Kx = K @ vectors
     Mx = M @ vectors
@@ -97,3 +97,6 @@ def residual_message(residual, limits, omega2) -> str | None:
     more = f"; and {over.size - MAX_NAMED} more modes" if over.size > MAX_NAMED else ""
     return ("eigen solve: " + "; ".join(named) + more
             + " (limit: 1e-6, or 100 times the residual's round-off level)")
+
+
+_residual_terms = residual_terms  # old name: femmech.solve.eigen imports it

@@ -1,7 +1,7 @@
 """Sturm-sequence checks of ``K x = λ M x``: how many eigenvalues lie below a cut
 (Sylvester's law of inertia, :func:`inertia_below`), where the cut above the last wanted
 eigenvalue lies, how many eigenvalues to return so that a cluster of equal ones is
-not cut (:func:`_complete_cluster`), and whether approximate eigenvalues sit at their
+not cut (:func:`complete_cluster`), and whether approximate eigenvalues sit at their
 claimed positions in the spectrum (:func:`confirm_indices`).
 
 Stage 1, solve (linear algebra): imports only :mod:`femmech.errors` and other
@@ -38,7 +38,7 @@ def inertia_below(K, M, cut: float, like=None) -> int | None:
     return lu.n_negative
 
 
-def _complete_cluster(omega2: np.ndarray, n_wanted: int, rtol: float = 1e-6) -> int:
+def complete_cluster(omega2: np.ndarray, n_wanted: int, rtol: float = 1e-6) -> int:
     """Count to return so that a cluster of equal eigenvalues is not cut at ``n_wanted``.
 
     Equal means within ``rtol`` of the n-th eigenvalue, with a floor of ``1e-6`` times the
@@ -55,7 +55,7 @@ def _complete_cluster(omega2: np.ndarray, n_wanted: int, rtol: float = 1e-6) -> 
     return n
 
 
-def _cut_above(lam: float, scale: float) -> float:
+def cut_above(lam: float, scale: float) -> float:
     """The Sturm cut just above ``lam``: 1e-6 of ``|lam|`` higher, at least 1e-12 of
     ``scale``."""
     return lam + 1e-6 * max(abs(lam), 1e-6 * scale)
@@ -138,7 +138,7 @@ def confirm_indices(K, M, lower: np.ndarray, upper: np.ndarray, index: np.ndarra
 
     if distinct and np.any(status == 0):
         top = float(upper.max())
-        if count(_cut_above(top, abs(top))) == int(index.max()):
+        if count(cut_above(top, abs(top))) == int(index.max()):
             order = np.argsort(index, kind="stable")
             above = np.minimum.accumulate(lower[order][::-1])[::-1]  # min over j >= k
             status[order[(status[order] == 0) & (lower[order] <= above)]] = 1
@@ -167,3 +167,7 @@ def _common_point_groups(lower, upper, open_) -> list[np.ndarray]:
     if current:
         groups.append(np.array(current))
     return groups
+
+
+_complete_cluster = complete_cluster  # old name: femmech.solve.eigen imports it
+_cut_above = cut_above  # old name: femmech.solve.eigen imports it

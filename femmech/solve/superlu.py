@@ -16,7 +16,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from femmech.solve import threads
-from femmech.solve.factor import Factor, _singular, _square
+from femmech.solve.factor import Factor, singular_error, square_matrix
 
 
 class SuperLUFactor(Factor):
@@ -25,7 +25,7 @@ class SuperLUFactor(Factor):
     name = "superlu"
 
     def __init__(self, A, pivot_threshold: float = 0.0, order=None):
-        A = _square(A)
+        A = square_matrix(A)
         super().__init__(A.shape[0], order)
         self.pivot_threshold = float(pivot_threshold)
         self._factor(A)
@@ -38,7 +38,7 @@ class SuperLUFactor(Factor):
                                 diag_pivot_thresh=self.pivot_threshold,
                                 options={"SymmetricMode": True})
         except RuntimeError as exc:
-            raise _singular(exc) from exc
+            raise singular_error(exc) from exc
         self.timings = {"analyse": 0.0, "factorise": time.perf_counter() - start}
 
     def _solve(self, b):

@@ -132,7 +132,7 @@ def refresh():
     _controller = None
 
 
-def _libraries() -> ThreadpoolController:
+def blas_controller() -> ThreadpoolController:
     """threadpoolctl's controller of the loaded BLAS/OpenMP libraries, cached.
 
     Looking the libraries up costs ~2.5 ms (``threadpool_limits`` does it on every
@@ -178,7 +178,7 @@ def _files(controller: ThreadpoolController) -> set[str]:
 
 def _switch(limits):
     """The libraries on ``limits`` threads in a ``with`` block (None: no change)."""
-    return nullcontext() if limits is None else _libraries().limit(limits=limits)
+    return nullcontext() if limits is None else blas_controller().limit(limits=limits)
 
 
 _outside: list = []  # thread counts before each enclosing phase (for gemm_phase)
@@ -190,7 +190,7 @@ def _limited(limits):
     if limits is None:
         yield
         return
-    _outside.append(_libraries().info())
+    _outside.append(blas_controller().info())
     try:
         with _switch(limits):
             yield

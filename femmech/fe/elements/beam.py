@@ -22,8 +22,8 @@ from __future__ import annotations
 import numpy as np
 
 # local DOF indices of the two bending planes, ordered (w_a, θ_a, w_b, θ_b) with θ = dw/dx
-_PLANE_XY = np.array([1, 5, 7, 11])  # deflection v, rotation rz = +dv/dx
-_PLANE_XZ = np.array([2, 4, 8, 10])  # deflection w, rotation ry = -dw/dx
+PLANE_XY = np.array([1, 5, 7, 11])  # deflection v, rotation rz = +dv/dx
+PLANE_XZ = np.array([2, 4, 8, 10])  # deflection w, rotation ry = -dw/dx
 _SIGN_XZ = np.array([1.0, -1.0, 1.0, -1.0])
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
 _XI = 0.5 * (_GAUSS_X + 1.0)
@@ -169,8 +169,8 @@ def local_matrices(length, E, G, rho, A, Iy, Iz, J, Ip, Asy, Asz, rotary_inertia
         M[:, idx[:, None], idx[None, :]] = (inertia * length)[:, None, None] * consistent_pair
     rot = np.asarray(rotary_inertia, dtype=float)
     for idx, inertia, shear_area, sign in (
-        (_PLANE_XY, Iz, Asy, None),
-        (_PLANE_XZ, Iy, Asz, _SIGN_XZ),
+        (PLANE_XY, Iz, Asy, None),
+        (PLANE_XZ, Iy, Asz, _SIGN_XZ),
     ):
         Kb, Mb = bending_matrices(length, E * inertia, G * shear_area, rho * A,
                                   rot * rho * inertia)

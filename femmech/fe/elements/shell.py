@@ -171,7 +171,7 @@ def shell_matrices(points, cells, E, nu, rho, thickness, shear_factor=SHEAR_FACT
     E, nu, rho, t = (np.broadcast_to(np.asarray(p, dtype=float), (n,)).copy()
                      for p in (E, nu, rho, thickness))
     G = E / (2.0 * (1.0 + nu))
-    C = _plane_stress(E, nu)
+    C = plane_stress(E, nu)
     if k == 4:
         N, dN, wdet = _quad_points(xy, _QUAD_GAUSS, np.ones(4))
         Km = _quad_membrane(xy, C * t[:, None, None])
@@ -222,7 +222,7 @@ def global_matrices(R, z, Km, Kb, N, dN, wdet, G, t, rho, drilling):
     return _to_global(R, K, T), _to_global(R, M, T)
 
 
-def _plane_stress(E, nu):
+def plane_stress(E, nu):
     """Plane-stress matrices ``E / (1 - ν²) [[1, ν, 0], [ν, 1, 0], [0, 0, (1 - ν)/2]]``."""
     C = np.zeros((len(E), 3, 3))
     C[:, 0, 0] = C[:, 1, 1] = 1.0
@@ -253,7 +253,7 @@ def _quad_points(xy, points, weights):
     return N, dN_xy, det * weights
 
 
-def _membrane_b(dN):
+def membrane_b(dN):
     """Strain-displacement rows (…, 3, 2 k) of plane stress, DOFs (u, v) per node."""
     B = np.zeros(dN.shape[:-2] + (3, 2 * dN.shape[-1]))
     B[..., 0, 0::2] = dN[..., 0, :]
@@ -263,7 +263,7 @@ def _membrane_b(dN):
     return B
 
 
-def _integrate(B, D, wdet):
+def integrate(B, D, wdet):
     """Σ_q w_q det J_q Bᵀ D B for B (n, q, r, m), D (n, r, r), wdet (n, q)."""
     return np.einsum("eqri,ers,eqsj,eq->eij", B, D, B, wdet, optimize=True)
 
@@ -271,7 +271,7 @@ def _integrate(B, D, wdet):
 def _quad_membrane(xy, Ct):
     """Membrane stiffness (n, 12, 12), DOFs (u, v, θz) per node, QM6 condensed."""
     _, dN, wdet = _quad_points(xy, _QUAD_GAUSS, np.ones(4))
-    Bc = _membrane_b(dN)
+    Bc = membrane_b(dN)
     # incompatible modes 1 - ξ², 1 - η² with the centre Jacobian (Taylor et al. 1976)
     _, dN0 = _quad_shape(np.zeros((1, 2)))
     J0 = np.einsum("ai,eib->eab", dN0[0], xy)
@@ -281,15 +281,15 @@ def _quad_membrane(xy, Ct):
     nat[:, 1, 1] = -2.0 * _QUAD_GAUSS[:, 1]
     dP = np.linalg.solve(J0[:, None], np.broadcast_to(nat, (len(xy), 4, 2, 2)))
     dP *= (det0[:, None] / (wdet))[:, :, None, None]
-    Bi = _membrane_b(dP)
-    Kcc = _integrate(Bc, Ct, wdet)
+    Bi = membrane_b(dP)
+    Kcc = integrate(Bc, Ct, wdet)
     Kci = np.einsum("eqri,ers,eqsj,eq->eij", Bc, Ct, Bi, wdet, optimize=True)
-    Kii = _integrate(Bi, Ct, wdet)
+    Kii = integrate(Bi, Ct, wdet)
     Km = Kcc - Kci @ np.linalg.solve(Kii, np.swapaxes(Kci, 1, 2))
-    return _expand_uv(Km, 4)
+    return expand_uv(Km, 4)
 
 
-def _expand_uv(Kuv, k):
+def expand_uv(Kuv, k):
     """(n, 2k, 2k) over (u, v) per node → (n, 3k, 3k) over (u, v, θz) per node."""
     idx = (3 * np.arange(k)[:, None] + np.arange(2)).ravel()
     K = np.zeros((len(Kuv), 3 * k, 3 * k))
@@ -315,7 +315,7 @@ def _quad_bending(xy, Db, Ds):
     Bb[..., 1, 1::3] = -dN_xy[..., 1, :]
     Bb[..., 2, 2::3] = dN_xy[..., 1, :]
     Bb[..., 2, 1::3] = -dN_xy[..., 0, :]
-    K = _integrate(Bb, Db, wdet)
+    K = integrate(Bb, Db, wdet)
     # tying points A (0,-1), C (0,1) for γ_ξ and D (-1,0), B (1,0) for γ_η (Bathe 1985)
     tying = np.array([[0.0, -1.0], [0.0, 1.0], [-1.0, 0.0], [1.0, 0.0]])
     Nt, dNt = _quad_shape(tying)
@@ -328,7 +328,7 @@ def _quad_bending(xy, Db, Ds):
     J = np.einsum("qai,eib->eqab", dN, xy)
     Bs = np.linalg.solve(J, np.stack([g_xi, g_eta], axis=2))  # γ_nat = J γ_xy
     eye = np.broadcast_to(np.eye(2), (len(xy), 2, 2)) * Ds[:, None, None]
-    return K + _integrate(Bs, eye, wdet)
+    return K + integrate(Bs, eye, wdet)
 
 
 def _triangle_points(xy):
@@ -345,8 +345,8 @@ def _triangle_points(xy):
 
 def _triangle_membrane(dN, area, Ct):
     """CST stiffness (n, 9, 9), DOFs (u, v, θz) per node."""
-    B = _membrane_b(dN)
-    return _expand_uv(area[:, None, None] * np.swapaxes(B, 1, 2) @ Ct @ B, 3)
+    B = membrane_b(dN)
+    return expand_uv(area[:, None, None] * np.swapaxes(B, 1, 2) @ Ct @ B, 3)
 
 
 def _triangle_bending(xy, dN, area, Db, Ds, t):
@@ -380,7 +380,7 @@ def _triangle_bending(xy, dN, area, Db, Ds, t):
     h2 = np.max(np.sum(tvec**2, axis=2), axis=1)
     ds = Ds * t**2 / (t**2 + STABILISATION * h2)
     eye = np.broadcast_to(np.eye(2), (n, 2, 2)) * ds[:, None, None]
-    return K + _integrate(Bs, eye, np.repeat(area[:, None] / 3.0, 3, axis=1))
+    return K + integrate(Bs, eye, np.repeat(area[:, None] / 3.0, 3, axis=1))
 
 
 def _drilling(N, dN, wdet, gamma_t):
@@ -390,7 +390,7 @@ def _drilling(N, dN, wdet, gamma_t):
     B[..., 0, 0::3] = 0.5 * dN[..., 1, :]
     B[..., 0, 1::3] = -0.5 * dN[..., 0, :]
     B[..., 0, 2::3] = N
-    return _integrate(B, gamma_t[:, None, None], wdet)
+    return integrate(B, gamma_t[:, None, None], wdet)
 
 
 def _scatter(K, part, comps, k):

@@ -78,12 +78,12 @@ from femmech.fe.elements.shell import (
     DRILLING,
     ELEMENT_CHUNK,
     SHEAR_FACTOR,
-    _expand_uv,
-    _integrate,
-    _membrane_b,
-    _plane_stress,
     batched,
+    expand_uv,
     global_matrices,
+    integrate,
+    membrane_b,
+    plane_stress,
     shell_frames,
 )
 
@@ -193,7 +193,7 @@ def _jacobians(xy, points):
     return N, dN, np.einsum("qai,eib->eqab", dN, xy)
 
 
-def _quadrature(xy):
+def quadrature(xy):
     """N (6, 6), Cartesian derivatives (n, 6, 2, 6), J (n, 6, 2, 2), w det J (n, 6)."""
     N, dN, J = _jacobians(xy, POINTS)
     det = J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
@@ -249,7 +249,7 @@ def _tied_shear(xy, J):
 def _bending(xy, Db, Ds):
     """MITC6 bending + shear stiffness (n, 18, 18), DOFs (w, θx, θy) per node, with
     the rotation bubble condensed (:data:`BUBBLE`)."""
-    _, dN_xy, J, wdet = _quadrature(xy)
+    _, dN_xy, J, wdet = quadrature(xy)
     _, db = bubble(POINTS)
     db_xy = np.linalg.solve(J, np.broadcast_to(db[:, :, None], J.shape[:2] + (2, 1)))[..., 0]
     Bb = np.zeros(dN_xy.shape[:2] + (3, 20))
@@ -263,7 +263,7 @@ def _bending(xy, Db, Ds):
     Bb[..., 2, 18] = -db_xy[..., 0]
     Bs = _tied_shear(xy, J)
     eye = np.broadcast_to(np.eye(2), (len(xy), 2, 2)) * Ds[:, None, None]
-    K = _integrate(Bb, Db, wdet) + _integrate(Bs, eye, wdet)
+    K = integrate(Bb, Db, wdet) + integrate(Bs, eye, wdet)
     if not BUBBLE:  # read at call time (a test measures the element without it)
         return K[:, :18, :18]
     Kab = K[:, :18, 18:]
@@ -306,9 +306,9 @@ def shell6_matrices(points, cells, E, nu, rho, thickness, shear_factor=SHEAR_FAC
     E, nu, rho, t, drill = (np.broadcast_to(np.asarray(p, dtype=float), (n,)).copy()
                             for p in (E, nu, rho, thickness, drilling))
     G = E / (2.0 * (1.0 + nu))
-    C = _plane_stress(E, nu)
-    N, dN_xy, _, wdet = _quadrature(xy)
-    Km = _expand_uv(_integrate(_membrane_b(dN_xy), C * t[:, None, None], wdet), 6)
+    C = plane_stress(E, nu)
+    N, dN_xy, _, wdet = quadrature(xy)
+    Km = expand_uv(integrate(membrane_b(dN_xy), C * t[:, None, None], wdet), 6)
     Kb = _bending(xy, C * (t**3 / 12.0)[:, None, None], shear_factor * G * t)
     return global_matrices(R, z, Km, Kb, N, dN_xy, wdet, G, t, rho, drill)
 

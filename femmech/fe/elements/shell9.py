@@ -96,12 +96,12 @@ from femmech.fe.elements.shell import (
     DRILLING,
     ELEMENT_CHUNK,
     SHEAR_FACTOR,
-    _expand_uv,
-    _integrate,
-    _membrane_b,
-    _plane_stress,
     batched,
+    expand_uv,
     global_matrices,
+    integrate,
+    membrane_b,
+    plane_stress,
     shell_frames,
 )
 
@@ -242,7 +242,7 @@ def _bending(xy, Db, Ds, lines):
     Bb[..., 2, 1::3] = -dN_xy[..., 0, :]
     Bs = _tied_shear(xy, J, lines)
     eye = np.broadcast_to(np.eye(2), (len(xy), 2, 2)) * Ds[:, None, None]
-    return _integrate(Bb, Db, wdet) + _integrate(Bs, eye, wdet)
+    return integrate(Bb, Db, wdet) + integrate(Bs, eye, wdet)
 
 
 def shell9_matrices(points, cells, E, nu, rho, thickness, shear_factor=SHEAR_FACTOR,
@@ -285,9 +285,9 @@ def shell9_matrices(points, cells, E, nu, rho, thickness, shear_factor=SHEAR_FAC
     E, nu, rho, t, drill = (np.broadcast_to(np.asarray(p, dtype=float), (n,)).copy()
                             for p in (E, nu, rho, thickness, drilling))
     G = E / (2.0 * (1.0 + nu))
-    C = _plane_stress(E, nu)
+    C = plane_stress(E, nu)
     N, dN_xy, _, wdet = _gauss(xy)
-    Km = _expand_uv(_integrate(_membrane_b(dN_xy), C * t[:, None, None], wdet), 9)
+    Km = expand_uv(integrate(membrane_b(dN_xy), C * t[:, None, None], wdet), 9)
     Kb = _bending(xy, C * (t**3 / 12.0)[:, None, None], shear_factor * G * t, TYING[tying])
     return global_matrices(R, z, Km, Kb, N, dN_xy, wdet, G, t, rho, drill)
 
