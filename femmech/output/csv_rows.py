@@ -1,7 +1,8 @@
 """Tables of rows as CSV files, written atomically: one header line, then one line per
 row; floats as ``repr`` (round-trip exact), other cells as they are.
 
-Stage 7 (output): uses output.export (atomic writes).
+Stage 7 (output): uses output.export (atomic writes), imported when writing: reading a
+scene (the kinds import this module) loads no analysis module.
 """
 
 from __future__ import annotations
@@ -12,11 +13,11 @@ from pathlib import Path
 
 import numpy as np
 
-from femmech.output.export import atomic_path
-
 
 def write_csv(path, header, rows) -> Path:
     """Write ``header`` (column names) and ``rows`` (sequences of cells) to ``path``."""
+    from femmech.output.export import atomic_path  # it imports the analysis results
+
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(header)

@@ -13,7 +13,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from femmech.output.csv_rows import write_csv
-from femmech.output.export import atomic_path
 from femmech.output.formatting import Quantity
 from femmech.output.report import Figure, Flagged, Section, Table
 from femmech.scene.kinds.common import (
@@ -80,6 +79,7 @@ def run(ws, spec, out):
     several reduction sizes (the speed-versus-error comparison)."""
     from femmech.coupling import couple
     from femmech.output import plot_mac
+    from femmech.output.export import atomic_path
     from femmech.output.speed_error import plot_speed_error
     from femmech.scene.build import machine_mounts
 

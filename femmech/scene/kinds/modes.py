@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from femmech.output.export import atomic_path
 from femmech.output.formatting import Quantity
 from femmech.output.report import Figure, Flagged, Section, Table, rigid_modes_note
 from femmech.scene.kinds.common import (
@@ -83,6 +82,7 @@ def run(ws, spec, out):
     from femmech.analysis.modes import modes, superelement_modes
     from femmech.output import export_modes_vtu, frequency_table, write_frequency_csv
     from femmech.output.animate import animate_mode
+    from femmech.output.export import atomic_path
     from femmech.output.series import write_mode_series
     from femmech.output.tables import error_budget_columns
     from femmech.scene.summary import participation_tables
