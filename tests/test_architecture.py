@@ -272,3 +272,16 @@ def test_registry_refuses_bad_entries():
         registry.ElementType("wedge", "membrane", wedge_matrices)
     assert registry.kinds("shell")[:2] == ("triangle", "quad")  # registration order
     assert "quad9" in registry.kinds("shell")
+
+
+def test_every_analysis_kind_module_is_registered():
+    """Each module of femmech/scene/kinds/ (but the shared one) is a registry entry with a
+    reader, a runner and a one-line description."""
+    from femmech.scene import registry
+
+    modules = sorted(p.stem for p in (PACKAGE / "scene" / "kinds").glob("*.py")
+                     if p.stem != "__init__" and p.stem not in registry.SHARED)
+    assert sorted(registry.KINDS) == modules
+    for kind in registry.KINDS.values():
+        assert callable(kind.read) and callable(kind.run), kind.name
+        assert kind.describe and "\n" not in kind.describe, kind.name
