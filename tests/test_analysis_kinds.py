@@ -67,3 +67,14 @@ def test_toy_kind_touches_one_module(monkeypatch, tmp_path):
     assert result.results == {"toy": {"length_m": 0.025}}
     assert json.loads((tmp_path / "out" / "results.json").read_text()) == result.results
     assert (tmp_path / "out" / "toy.txt").read_text() == "0.025\n"
+
+
+def test_docs_list_every_kind():
+    """docs/scenes.md lists each registered kind once, with its description, and nothing
+    else, in run order."""
+    import re
+
+    text = (ROOT / "docs" / "scenes.md").read_text(encoding="utf-8")
+    listed = re.findall(r"^- `\[(?:analyses\.)?(\w+)\]`: (.*)\.$", text, flags=re.M)
+    assert [name for name, _ in listed] == list(KINDS)
+    assert all(KINDS[name].describe == line for name, line in listed)

@@ -283,5 +283,7 @@ def test_every_analysis_kind_module_is_registered():
                      if p.stem != "__init__" and p.stem not in registry.SHARED)
     assert sorted(registry.KINDS) == modules
     for kind in registry.KINDS.values():
-        assert callable(kind.read) and callable(kind.run), kind.name
-        assert kind.describe and "\n" not in kind.describe, kind.name
+        assert callable(kind.read), kind.name
+        assert callable(kind.run), kind.name
+        assert kind.describe, kind.name
+        assert "\n" not in kind.describe, kind.name
