@@ -107,8 +107,7 @@ def _check(args) -> int:
         prepared = prepare(load_scene(path), code_root=args.code_root, run_code=False)
     scene = prepared.scene
     parts = ", ".join(f"{n} ({m.n_nodes} nodes)" for n, m in prepared.meshes.items())
-    analyses = [k for k in ("modes", "sweep", "stability", "response", "check", "drive_event")
-                if getattr(scene.analyses, k) is not None]
+    analyses = list(scene.analyses.requested())  # every kind a run executes, in run order
     print(f"{path.name}: OK: parts {parts or '-'}; mechanisms {list(scene.mechanisms) or '-'};"
           f" mounts {len(scene.mounts)}; analyses {analyses}")
     for name in prepared.unexecuted:

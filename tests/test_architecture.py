@@ -446,3 +446,18 @@ def test_package_docstrings_name_their_modules():
     missing = undocumented_modules()
     assert not missing, "name these in their package's __init__ docstring:\n" + "\n".join(
         missing)
+
+
+def test_every_analysis_kind_module_is_registered():
+    """Each module of femmech/scene/kinds/ (but the shared one) is a registry entry with a
+    reader, a runner and a one-line description."""
+    from femmech.scene import registry
+
+    modules = sorted(p.stem for p in (PACKAGE / "scene" / "kinds").glob("*.py")
+                     if p.stem != "__init__" and p.stem not in registry.SHARED)
+    assert sorted(registry.KINDS) == modules
+    for kind in registry.KINDS.values():
+        assert callable(kind.read), kind.name
+        assert callable(kind.run), kind.name
+        assert kind.describe, kind.name
+        assert "\n" not in kind.describe, kind.name

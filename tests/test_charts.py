@@ -13,6 +13,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+import femmech.analysis.stability
+import femmech.mechanisms
 from femmech.analysis.stability import StabilityChart
 from femmech.errors import SceneError
 from femmech.output.charts import (
@@ -28,8 +30,11 @@ from femmech.output.charts import (
 )
 from femmech.output.histories import plot_time_histories, time_histories_figure
 from femmech.output.sweeps import quasi_frequency_figure
-from femmech.scene import tasks
-from femmech.scene.analyses import SPEED_UNITS, StabilitySpec, SweepSpec
+from femmech.scene.kinds import stability as stability_kind
+from femmech.scene.kinds import sweep as sweep_kind
+from femmech.scene.kinds.common import SPEED_UNITS
+from femmech.scene.kinds.stability import StabilitySpec
+from femmech.scene.kinds.sweep import SweepSpec
 from femmech.scene.load import Scene
 
 RPM = 60 / (2 * math.pi)  # rad/s → rpm
@@ -286,11 +291,11 @@ def test_sweep_task_shows_speeds_in_the_scene_unit(monkeypatch, tmp_path, unit):
         return SimpleNamespace(phi=phi, freq_hz=np.column_stack([50 + 0 * phi + Omega,
                                                                  90 + 0 * phi]))
 
-    monkeypatch.setattr(tasks, "quasi_modes", fake_quasi_modes)
+    monkeypatch.setattr(femmech.mechanisms, "quasi_modes", fake_quasi_modes)
     speeds = (0.0, 1200 / RPM)
     spec = SweepSpec(tuple(np.linspace(0, 2 * np.pi, 9)), 2, speeds, "m", True, (),
                      speed_unit=unit)
-    section, results = tasks.run_sweep(workshop(), spec, tmp_path)
+    section, results = sweep_kind.run(workshop(), spec, tmp_path)
     with open(tmp_path / "quasi_frequencies.csv", newline="") as f:
         rows = list(csv.reader(f))
     column = {"rpm": "speed_rpm", "rad/s": "speed_rad_s"}[unit]
@@ -314,12 +319,12 @@ def test_stability_task_shows_speeds_in_the_scene_unit(monkeypatch, tmp_path, un
                               converged=np.array([[W < 140]]), n_steps=np.array([[64]]),
                               rtol=1e-4)
 
-    monkeypatch.setattr(tasks, "stability_chart", fake_chart)
+    monkeypatch.setattr(femmech.analysis.stability, "stability_chart", fake_chart)
     speeds = tuple(np.linspace(80.0, 150.0, 8))  # rad/s: 110, 120 unstable; 150 loose
     spec = StabilitySpec(speeds, 32, 2 * np.pi, (0.0, 0.0), 1e-6, 1e-4, 256,
                          speed_unit=unit)
     ws = workshop()
-    section, results = tasks.run_stability(ws, spec, tmp_path)
+    section, results = stability_kind.run(ws, spec, tmp_path)
     with open(tmp_path / "stability.csv", newline="") as f:
         rows = list(csv.DictReader(f))
     column = {"rpm": "speed_rpm", "rad/s": "speed_rad_s"}[unit]

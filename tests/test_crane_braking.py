@@ -24,7 +24,8 @@ from femmech.analysis.nonlinear import integrate_second_kind
 from femmech.analysis.response import SpeedRamp
 from femmech.cli import main
 from femmech.errors import SceneError
-from femmech.scene import Scene, prepare, tasks
+from femmech.output import histories
+from femmech.scene import Scene, prepare
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 EPS = np.finfo(float).eps
@@ -256,13 +257,13 @@ def test_second_kind_mechanisms_are_refused_where_rheolinear_is_needed():
 def test_crane_scene_runs_end_to_end(tmp_path, monkeypatch):
     out = tmp_path / "out"
     panels = []
-    plot = tasks.plot_event_histories
+    plot = histories.plot_event_histories
 
     def record(histories, *args, **kwargs):
         panels.extend(histories)
         return plot(histories, *args, **kwargs)
 
-    monkeypatch.setattr(tasks, "plot_event_histories", record)
+    monkeypatch.setattr(histories, "plot_event_histories", record)
     assert main(["run", str(TOML), "--out", str(out), "--no-cache", "-q"]) == 0
     files = {"drive_event.png", "report.html", "results.json", "run.log",
              "drive_event_braking_0p2s.csv", "drive_event_braking_0p5s.csv",

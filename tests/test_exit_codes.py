@@ -4,6 +4,7 @@ real process), with the one-line error and its normalised paths."""
 
 from __future__ import annotations
 
+import dataclasses
 import errno
 import os
 import re
@@ -15,8 +16,8 @@ import numpy as np
 import pytest
 from scene_texts import frame_scene
 
-import femmech.scene.tasks as tasks
 from femmech.cli import EXIT_CODES, main
+from femmech.scene.registry import KINDS
 
 ROOT = Path(__file__).resolve().parent.parent
 ROW = re.compile(r"^\| (\d+) \| (.+) \|$", re.M)
@@ -64,7 +65,8 @@ def exits_0(tmp_path, monkeypatch, capsys):
 
 
 def exits_1(tmp_path, monkeypatch, capsys):
-    monkeypatch.setitem(tasks.TASKS, "modes", failing_modes(KeyError("missing")))
+    monkeypatch.setitem(KINDS, "modes",
+                        dataclasses.replace(KINDS["modes"], run=failing_modes(KeyError("missing"))))
     code = main(run_args(tmp_path))
     assert error_line(capsys).startswith("internal error: KeyError")
     return code
@@ -91,7 +93,8 @@ def exits_3(tmp_path, monkeypatch, capsys):
 
 def exits_4(tmp_path, monkeypatch, capsys):
     failure = np.linalg.LinAlgError("Singular matrix")
-    monkeypatch.setitem(tasks.TASKS, "modes", failing_modes(failure))
+    monkeypatch.setitem(KINDS, "modes",
+                        dataclasses.replace(KINDS["modes"], run=failing_modes(failure)))
     code = main(run_args(tmp_path))
     assert error_line(capsys).startswith("numerical failure: frame.toml: [analyses.modes]")
     return code
@@ -113,7 +116,8 @@ def exits_5(tmp_path, monkeypatch, capsys):
 
 
 def exits_130(tmp_path, monkeypatch, capsys):
-    monkeypatch.setitem(tasks.TASKS, "modes", failing_modes(KeyboardInterrupt()))
+    monkeypatch.setitem(KINDS, "modes",
+                        dataclasses.replace(KINDS["modes"], run=failing_modes(KeyboardInterrupt())))
     code = main(run_args(tmp_path))
     assert error_line(capsys) == "interrupted"
     return code

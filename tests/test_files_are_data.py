@@ -3,6 +3,7 @@ folder, one consistent output folder per run, documented exit codes with one-lin
 
 from __future__ import annotations
 
+import dataclasses
 import errno
 import os
 import subprocess
@@ -13,12 +14,12 @@ import numpy as np
 import pytest
 from scene_texts import frame_scene
 
-import femmech.scene.tasks as tasks
 from femmech.cli import FILESYSTEM, INPUT, INTERNAL, NUMERICAL, main
 from femmech.errors import InputError, UserCodeError
 from femmech.output.folder import MANIFEST
 from femmech.scene.build import prepare
 from femmech.scene.load import load_scene
+from femmech.scene.registry import KINDS
 from femmech.scene.run import run_scene
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -241,7 +242,7 @@ def test_failed_run_leaves_the_previous_run_intact(tmp_path, monkeypatch):
         (folder / "frequencies.csv").write_text("half")
         raise RuntimeError("eigensolver broke")
 
-    monkeypatch.setitem(tasks.TASKS, "modes", broken)
+    monkeypatch.setitem(KINDS, "modes", dataclasses.replace(KINDS["modes"], run=broken))
     with pytest.raises(RuntimeError, match=r"\[analyses.modes\]: the computation failed"):
         run_scene(frame_scene(tmp_path), out, cache_dir=None)
     assert _tree(out, ()) == before
@@ -301,7 +302,7 @@ def test_numerical_failure_exits_4_naming_the_analysis(tmp_path, monkeypatch, ca
     def diverges(ws, spec, folder):
         raise RuntimeError("ARPACK did not converge")
 
-    monkeypatch.setitem(tasks.TASKS, "modes", diverges)
+    monkeypatch.setitem(KINDS, "modes", dataclasses.replace(KINDS["modes"], run=diverges))
     code = main(["run", str(frame_scene(tmp_path)), "--out", str(tmp_path / "o"), "--no-cache"])
     assert code == NUMERICAL
     err = one_line(capsys.readouterr().err)
@@ -313,7 +314,7 @@ def test_internal_error_exits_1_with_traceback_only_under_debug(tmp_path, monkey
     def bug(ws, spec, folder):
         return {}["missing"]
 
-    monkeypatch.setitem(tasks.TASKS, "modes", bug)
+    monkeypatch.setitem(KINDS, "modes", dataclasses.replace(KINDS["modes"], run=bug))
     args = ["run", str(frame_scene(tmp_path)), "--out", str(tmp_path / "o"), "--no-cache"]
     assert main(args) == INTERNAL
     err = one_line(capsys.readouterr().err)

@@ -199,7 +199,7 @@ def test_reduced_versus_full_rows_name_the_full_mode_they_match():
     full mode 2); a mixed pair of equal frequencies (MAC off the diagonal, same
     frequency) keeps its numbers."""
     from femmech.analysis.reference import Comparison
-    from femmech.scene.tasks import matched_full_modes
+    from femmech.scene.kinds.check import matched_full_modes
 
     missed = np.zeros((1, 4, 4))
     missed[0, [0, 1, 2, 3], [0, 2, 3, 3]] = 1.0

@@ -1,19 +1,18 @@
-"""Scene tables ``[chain]``, ``[analyses.chain_sweep]``, ``[analyses.campbell]`` and
-``[synthesis]``: a main shaft carrying N identical, phased cam-follower units
-(:mod:`femmech.chain`), its quasi-eigenfrequencies over the drive angle by several
-methods, its Campbell diagram and the choice of design parameters that keeps them out of
-the drive harmonics.
+"""Scene tables ``[chain]`` and ``[synthesis]``: a main shaft carrying N identical, phased
+cam-follower units (:mod:`femmech.chain`) and the choice of design parameters that keeps
+its quasi-eigenfrequencies out of the drive harmonics. Its analyses are analysis kinds
+(:mod:`femmech.scene.kinds.chain_sweep`, ``campbell``, ``synthesis``).
 
-Reading (:func:`read_chain`, :func:`read_chain_sweep`, :func:`read_campbell`,
-:func:`read_synthesis`) checks every value at its key (units, ranges, unknown keys, the
-cam programme) and returns frozen specs in SI units; nothing is built. :func:`build_chain`
-turns a :class:`ChainSpec` (with optional design-parameter values, :data:`DESIGN`) into a
-:class:`femmech.chain.Chain`. Scene data are never executed: the unit is the built-in
-cam follower (:func:`femmech.chain.follower_unit`) with a cam programme
+Reading (:func:`read_chain`, :func:`read_synthesis`) checks every value at its key
+(units, ranges, unknown keys, the cam programme) and returns frozen specs in SI units;
+nothing is built. :func:`build_chain` turns a :class:`ChainSpec` (with optional
+design-parameter values, :data:`DESIGN`) into a :class:`femmech.chain.Chain`. Scene data
+are never executed: the unit is the built-in cam follower
+(:func:`femmech.chain.follower_unit`) with a cam programme
 (:func:`femmech.mechanisms.cam_program`).
 
-Stage 8 (scene), reading and building: uses scene.reader, scene.units, scene.analyses
-(value lists and limits), chain and mechanisms.
+Stage 8 (scene), reading and building: uses scene.reader, scene.units,
+scene.kinds.common (the shared readers), chain and mechanisms.
 """
 
 from __future__ import annotations
@@ -30,20 +29,24 @@ from femmech.mechanisms import cam_program
 from femmech.mechanisms.motion_laws import LAWS
 from femmech.output.formatting import Quantity
 from femmech.output.report import Table
-from femmech.scene.analyses import MAX_MODES, read_values
+from femmech.scene.kinds.common import (
+    needs_chain,
+    read_harmonics,
+    read_margin,
+    read_n_modes,
+    read_speed_range,
+)
 from femmech.scene.reader import Reader, show
 from femmech.scene.units import (
     ANGLE,
     DAMPING,
     DENSITY,
-    DIMENSIONLESS,
     FORCE,
     INERTIA,
     LENGTH,
     MASS,
     PRESSURE,
     ROT_STIFFNESS,
-    SPEED,
     STIFFNESS,
     Kind,
 )
@@ -51,8 +54,6 @@ from femmech.scene.units import (
 MAX_UNITS = 10_000
 """Most units of a chain (the assembled model is solved densely below 400 coordinates,
 then sparse: :data:`femmech.chain.transfer.DENSE_MAX`; the transfer method is O(N))."""
-MAX_HARMONICS = 100
-"""Highest drive harmonic k·Ω of a Campbell diagram or a synthesis."""
 MAX_STARTS = 64
 """Most starting points of a synthesis (each a local optimisation)."""
 MAX_ANGLES = 3600
@@ -142,28 +143,6 @@ class ChainSpec:
     cells: bool
     where: str = field(default="chain", compare=False)
     ground_stiffness: float = 0.0
-
-
-@dataclass(frozen=True)
-class ChainSweepSpec:
-    """Quasi-eigenfrequencies of the chain over the drive angles (rad) by ``methods``."""
-
-    methods: tuple
-    n_modes: int
-    angles: tuple
-
-
-@dataclass(frozen=True)
-class CampbellSpec:
-    """Campbell diagram: the quasi-eigenfrequency bands (over ``angles``, rad) of the
-    ``n_modes`` lowest branches against the drive speed range ``speeds`` = (lo, hi) rad/s,
-    with the harmonics 1..``harmonics`` and the relative ``margin`` around their bands."""
-
-    speeds: tuple
-    harmonics: int
-    n_modes: int
-    angles: tuple
-    margin: float
 
 
 @dataclass(frozen=True)
@@ -362,81 +341,25 @@ def with_design(spec: ChainSpec, values: dict) -> ChainSpec:
     return out
 
 
-# --- analyses ----------------------------------------------------------------------------
+# --- the synthesis table (read with the scene; its kind: femmech.scene.kinds.synthesis) --
 
-def _angles(t: Reader, n: int) -> tuple:
-    return read_values(t, "angles", ANGLE, tuple(np.linspace(0, 2 * np.pi, n).tolist()))
-
-
-def _n_modes(t: Reader, default: int) -> int:
-    return t.integer("n_modes", default, minimum=1, maximum=MAX_MODES, limit="MAX_MODES")
+def chain_analyses(chain_spec) -> dict:
+    """What the readers of the analysis kinds need of ``[chain]``: ``{"chain": spec or
+    None}``, the ``extra`` of :func:`femmech.scene.analyses.read_analyses`."""
+    return {"chain": chain_spec}
 
 
-def _method_list(t: Reader, key: str, default: tuple) -> tuple:
-    methods = t.strings(key, default)
-    if not methods:
-        raise t.error(key, f"expected at least one of {list(METHODS)}")
-    for m in methods:
-        if m not in METHODS:
-            raise t.error(key, f"expected names of {list(METHODS)}, got {show(m)}")
-    if len(set(methods)) < len(methods):
-        raise t.error(key, f"a method is named twice: {show(list(methods))}")
-    return methods
-
-
-def _speed_range(t: Reader, key: str = "speeds") -> tuple:
-    value = t.get(key)
-    if not isinstance(value, list) or len(value) != 2:
-        raise t.error(key, f"expected [lowest, highest] drive speed, e.g. ['1200 rpm',"
-                           f" '1400 rpm'], got {show(value)}")
-    lo, hi = (t.convert(key, v, SPEED) for v in value)
-    if not 0 < lo < hi:
-        raise t.error(key, f"expected 0 < lowest < highest, got {show(value)}")
-    return lo, hi
-
-
-def _margin(t: Reader, default: float) -> float:
-    margin = t.number("margin", DIMENSIONLESS, default, non_negative=True)
-    if not margin < 0.5:
-        raise t.error("margin", f"expected a relative margin below 0.5 (e.g. 0.03 for 3 %),"
-                                f" got {margin:g}")
-    return margin
-
-
-def _harmonics(t: Reader) -> int:
-    return t.integer("harmonics", minimum=1, maximum=MAX_HARMONICS, limit="MAX_HARMONICS")
-
-
-def _needs_chain(t: Reader, chain_spec) -> None:
-    if chain_spec is None:
-        raise t.error(None, "needs a chain: add a [chain] table")
-
-
-def read_chain_sweep(t: Reader, chain_spec) -> ChainSweepSpec:
-    """``[analyses.chain_sweep]``: methods (default assembled, transfer, continuum),
-    n_modes (6), angles (0..360°, 73)."""
-    t.expect("methods", "n_modes", "angles")
-    _needs_chain(t, chain_spec)
-    methods = _method_list(t, "methods", ("assembled", "transfer", "continuum"))
-    return ChainSweepSpec(methods, _n_modes(t, 6), _angles(t, 73))
-
-
-def read_campbell(t: Reader, chain_spec) -> CampbellSpec:
-    """``[analyses.campbell]``: speeds [lo, hi], harmonics K, n_modes (6), angles (0..360°,
-    37), margin (0.03)."""
-    t.expect("speeds", "harmonics", "n_modes", "angles", "margin")
-    _needs_chain(t, chain_spec)
-    return CampbellSpec(_speed_range(t), _harmonics(t), _n_modes(t, 6), _angles(t, 37),
-                        _margin(t, 0.03))
+SYNTHESIS_KEYS = ("parameters", "speeds", "harmonics", "margin", "starts", "n_modes",
+                  "n_angles", "objective", "seed")
+"""Keys of the table ``[synthesis]``."""
 
 
 def read_synthesis(t: Reader, chain_spec) -> SynthesisSpec:
     """``[synthesis]``: parameters {name = [low, high]}, speeds [lo, hi], harmonics,
     margin (0.03), starts (8), n_modes (all), n_angles (72), objective ("closest"),
     seed (0)."""
-    t.expect("parameters", "speeds", "harmonics", "margin", "starts", "n_modes", "n_angles",
-             "objective", "seed")
-    _needs_chain(t, chain_spec)
+    t.expect(*SYNTHESIS_KEYS)
+    needs_chain(t, chain_spec)
     p = t.table("parameters")
     p.expect(*DESIGN)
     if not p.data:
@@ -446,8 +369,8 @@ def read_synthesis(t: Reader, chain_spec) -> SynthesisSpec:
     params = tuple((name, *_bounds(p, name, current[name], chain_spec))
                    for name in p.data)
     starts = t.integer("starts", 8, minimum=1, maximum=MAX_STARTS, limit="MAX_STARTS")
-    return SynthesisSpec(params, _speed_range(t), _harmonics(t), _margin(t, 0.03), starts,
-                         _n_modes(t, None),
+    return SynthesisSpec(params, read_speed_range(t), read_harmonics(t),
+                         read_margin(t, 0.03), starts, read_n_modes(t, None),
                          t.integer("n_angles", 72, minimum=1, maximum=MAX_ANGLES,
                                    limit="MAX_ANGLES"),
                          t.string("objective", "closest", choices=("closest", "max_margin")),
@@ -476,13 +399,6 @@ def _bounds(p: Reader, name: str, current: float, spec: ChainSpec) -> tuple:
         raise p.error(name, f"the scene's value {current:.6g} (SI) lies outside the bounds"
                             f" {show(value)}; the synthesis starts from it")
     return lo, hi
-
-
-def chain_analyses(chain_spec) -> dict:
-    """{kind: reader(table) -> spec} of the chain's analysis tables, for
-    :func:`femmech.scene.analyses.read_analyses`."""
-    return {"chain_sweep": lambda t: read_chain_sweep(t, chain_spec),
-            "campbell": lambda t: read_campbell(t, chain_spec)}
 
 
 # --- report ------------------------------------------------------------------------------
@@ -543,44 +459,16 @@ METHOD_NAMES = {"assembled": "assembled model (dense/sparse eigen solve)",
 """What each method is, for captions."""
 
 
-def plot_method_sweeps(sweeps: dict, path, title: str = "", bands=None) -> None:
-    """Quasi-eigenfrequencies over the drive angle, one panel per method side by side,
-    with a common frequency axis (Hz) so the panels compare at a glance.
+def __getattr__(name: str):
+    """Names this module had before the analysis kinds got their modules, from their new
+    places (docs/architecture.md, "Moved names")."""
+    from femmech.deprecation import moved
 
-    ``sweeps``: method → result with ``phi`` (n_angles,) rad and ``freq_hz`` (n_angles,
-    k) Hz. ``bands``: optional (lo_hz, hi_hz) arrays of harmonic bands, shaded grey.
-    """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure as MplFigure
-
-    from femmech.output.charts import set_angle_axis
-    from femmech.output.export import atomic_path
-
-    n = len(sweeps)
-    fig = MplFigure(figsize=(3.3 * n + 1.0, 4.4), dpi=110)
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(1, n, sharey=True, squeeze=False)[0]
-    values = np.concatenate([np.ravel(s.freq_hz) for s in sweeps.values()])
-    top = float(np.nanmax(values)) * 1.06
-    colors = [f"C{k % 10}" for k in range(max(s.freq_hz.shape[1] for s in sweeps.values()))]
-    for ax, (method, s) in zip(axes, sweeps.items(), strict=True):
-        deg = np.rad2deg(np.asarray(s.phi))
-        for k in range(s.freq_hz.shape[1]):
-            ax.plot(deg, s.freq_hz[:, k], color=colors[k], lw=1.4, label=f"f{k + 1}")
-        if bands is not None:
-            for lo, hi in zip(*bands, strict=True):
-                if lo < top:
-                    ax.axhspan(lo, hi, color="0.85", zorder=0, lw=0)
-        ax.set_title(method, fontsize=10)
-        set_angle_axis(ax, float(deg.min()), float(deg.max()))
-        ax.set_xlabel("drive angle φ (°)")
-        ax.grid(True, alpha=0.3)
-    axes[0].set_ylim(0.0, top)
-    axes[0].legend(fontsize=7, ncol=3, loc="lower right", title="branch (tracked)",
-                   title_fontsize=7)
-    axes[0].set_ylabel("quasi-eigenfrequency (Hz)")
-    if title:
-        fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png")
+    return moved(__name__, name, {
+        "CampbellSpec": "femmech.scene.kinds.campbell.CampbellSpec",
+        "ChainSweepSpec": "femmech.scene.kinds.chain_sweep.ChainSweepSpec",
+        "MAX_HARMONICS": "femmech.scene.kinds.common.MAX_HARMONICS",
+        "plot_method_sweeps": "femmech.output.chain_plots.plot_method_sweeps",
+        "read_campbell": "femmech.scene.kinds.campbell.read",
+        "read_chain_sweep": "femmech.scene.kinds.chain_sweep.read",
+    })

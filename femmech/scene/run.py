@@ -9,8 +9,8 @@ unreduced coupled machine is built only for the full-versus-reduced check. Resul
 the report page (``report.html``), ``results.json`` (key numbers, no timings: identical
 for identical inputs), ``run.log`` and the files of each analysis.
 
-Stage 8 (scene), the top: uses scene.tasks, scene.workshop, scene.build, the cache and
-output; only femmech.cli and the package's __init__ import it.
+Stage 8 (scene), the top: uses scene.registry (the analysis kinds), scene.workshop,
+scene.build, the cache and output; only femmech.cli and the package's __init__ import it.
 """
 
 from __future__ import annotations
@@ -36,8 +36,8 @@ from femmech.scene.build import (
 )
 from femmech.scene.cache_folder import default_cache_dir
 from femmech.scene.load import Scene, load_scene
+from femmech.scene.registry import KINDS
 from femmech.scene.summary import appendix_section, summary_section
-from femmech.scene.tasks import TASKS
 from femmech.scene.workshop import Workshop, progress
 from femmech.version import __version__
 
@@ -136,7 +136,7 @@ def run_scene(scene, out, cache_dir=DEFAULT, log: Callable[[str], None] | None =
         for line in finding_lines(prepared):
             emit(line)
         sections, results = [], {}
-        requested = [k for k in TASKS if getattr(scene.analyses, k) is not None]
+        requested = scene.analyses.requested()
         for kind in progress(requested, "analyses", bars):
             with ws.timed(f"analysis {kind}"), logged_warnings(emit, f"analysis {kind}"):
                 section, numbers = _analysis(ws, kind, stage)
@@ -166,11 +166,11 @@ and OverflowError); reported as NumericalError."""
 
 
 def _analysis(ws: Workshop, kind: str, out: Path):
-    """Run one analysis task; its errors named at ``[analyses.<kind>]``."""
+    """Run one analysis kind; its errors named at its table (``[analyses.<kind>]``)."""
 
     scene = ws.scene
     try:
-        return TASKS[kind](ws, getattr(scene.analyses, kind), out)
+        return KINDS[kind].run(ws, scene.analyses.specs[kind], out)
     except (SceneError, NumericalError):
         raise
     except NUMERICAL_FAILURES as exc:  # valid input, failed computation
