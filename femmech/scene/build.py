@@ -35,7 +35,6 @@ from femmech.fe.constraints import InterpolatingLink, RigidLink, Support
 from femmech.fe.dofs import COMPONENTS
 from femmech.fe.generators import grid_frame, members_frame
 from femmech.fe.lumped import PointMass, Spring
-from femmech.fe.materials import Material
 from femmech.fe.mesh import Mesh
 from femmech.fe.mesh_io import read_mesh
 from femmech.fe.model import (
@@ -421,8 +420,7 @@ def part_findings(scene: Scene, part: PartSpec, mesh: Mesh) -> tuple:
 
 def _model_args(scene: Scene, part: PartSpec) -> dict:
     """Keyword arguments of :func:`femmech.build_model` for the part (without the mesh)."""
-    mats = {n: Material(E=m.E, rho=m.rho, nu=m.nu, G=m.G, name=n)
-            for n, m in scene.materials.items()}
+    mats = scene.materials
     beams, shells, solids = {}, {}, {}
     for s in part.sections:
         section = _section(s)
