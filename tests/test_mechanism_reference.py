@@ -219,3 +219,55 @@ def test_the_chapter_symbol_table_agrees_with_the_catalogue():
         units = {x.name: x.unit for x in
                  entry.coordinates + entry.parameters + entry.position_functions}
         assert units.get(name) == unit, (model, name, unit, units.get(name))
+
+
+def test_every_registered_mechanism_type_has_factory_parameters_and_quantities():
+    """One registration per mechanism type: its factory, its parameters with a dimension
+    the scene knows, its coordinates and output quantities; the scene accepts exactly the
+    registered names."""
+    import inspect
+
+    from femmech.mechanisms.registry import MECHANISM_TYPES
+    from femmech.scene import machine
+
+    assert set(MECHANISM_TYPES) == {"cam_follower", "slider_crank", "table_5_1_case",
+                                    "processing_machine", "mobile_crane"}
+    assert machine.BUILTIN_MODELS == {n: t.factory for n, t in MECHANISM_TYPES.items()}
+    for name, kind in MECHANISM_TYPES.items():
+        assert callable(kind.factory)
+        options = {"case": 1} if name == "table_5_1_case" else {}
+        signature = inspect.signature(kind.factory).parameters
+        assert set(options) <= set(signature)
+        units = kind.parameter_units(options)
+        assert units
+        assert all(machine.UNIT_KINDS.get(u) is not None for u in units.values())
+        quantities = kind.quantities(options)
+        assert quantities
+        assert all(c.unit for c in quantities)
+        spec = machine.MechanismSpec("m", name, None, None, options, {}, ())
+        assert machine.parameter_kinds(spec) == {n: machine.UNIT_KINDS[u]
+                                                 for n, u in units.items()}
+
+
+def test_a_role_renamed_by_an_option_keeps_its_dimension():
+    from femmech.scene import machine
+    from femmech.scene.units import INERTIA, MASS, STIFFNESS
+
+    spec = machine.MechanismSpec("m", "cam_follower", None, None,
+                                 {"m": "m_f", "J": "J_cam"}, {}, ())
+    kinds = machine.parameter_kinds(spec)
+    assert kinds["m_f"] == MASS
+    assert kinds["J_cam"] == INERTIA
+    assert "m" not in kinds
+    assert kinds["c_r"] == STIFFNESS  # a role left at its default name
+    assert "J" not in machine.parameter_kinds(machine.MechanismSpec(
+        "m", "cam_follower", None, None, {}, {}, ()))  # J unset: no rotary inertia
+
+
+def test_registering_a_mechanism_type_twice_is_refused():
+    from femmech.mechanisms.registry import MECHANISM_TYPES, MechanismType, register
+
+    with pytest.raises(ValueError, match="'cam_follower' is already registered"):
+        register(MechanismType("cam_follower", MECHANISM_TYPES["cam_follower"].factory))
+    with pytest.raises(ValueError, match="no catalogue entry 'toy\\(\\)'"):
+        MechanismType("toy", print)

@@ -47,3 +47,20 @@ def test_warnings_of_preparing_a_scene_reach_the_run_log(tmp_path):
     assert any("cards not carried into the model: CONM2 x1" in line for line in lines)
     assert any("CONM2 x1" in line
                for line in (tmp_path / "out" / "run.log").read_text().splitlines())
+
+
+
+def test_material_errors_come_from_the_library_at_the_key_they_name():
+    """The scene reads [materials.<name>] straight into femmech.fe.materials.Material: its
+    checks (here E outside MODULUS_RANGE, which the scene did not check) name the key."""
+    import pytest
+
+    from femmech.errors import SceneError
+    from femmech.scene import Scene
+
+    data = {"materials": {"steel": {"E": 1e-150, "rho": 7850.0, "nu": 0.3}}}
+    with pytest.raises(SceneError, match=r"\[materials\.steel\] E: E = 1e-150 .*MODULUS_RANGE"):
+        Scene.from_dict(data)
+    data["materials"]["steel"] = {"E": "210 GPa", "rho": 7850.0, "nu": 0.7}
+    with pytest.raises(SceneError, match=r"\[materials\.steel\] nu: nu must lie in"):
+        Scene.from_dict(data)

@@ -488,3 +488,34 @@ def test_auto_mesh_that_cannot_meet_its_target_says_so():
     data["parts"]["p"]["generator"]["element"] = "quad9"
     with pytest.warns(ModelWarning, match="still exceeds target_error 0.001"):
         sized(data)
+
+
+@pytest.mark.parametrize("data", [frame_scene(1e-3), shell_scene("rectangular_plate", 1e-2)],
+                         ids=["beams n_modes band", "shells (estimator check)"])
+def test_planning_an_auto_mesh_solves_nothing_and_the_run_sizes_the_same_mesh(data,
+                                                                            monkeypatch):
+    """prepare (what `femmech check` runs) sizes no mesh that needs eigen solves; the
+    mesh looked up afterwards is the one sizing in planning gave (same counts, points)."""
+    from femmech.analysis import discretisation, modes
+    from femmech.scene import Scene, prepare
+    from femmech.scene.build import part_mesh
+
+    scene = Scene.from_dict(data)
+    name = next(iter(scene.parts))
+    reference = part_mesh(scene, scene.parts[name])  # sized in one go, as planning did
+
+    def refuse(*a, **k):
+        raise AssertionError("planning solved an eigenproblem")
+
+    with monkeypatch.context() as m:
+        m.setattr(modes, "modes", refuse)
+        m.setattr(discretisation, "discretisation_error", refuse)
+        prepared = prepare(scene)
+        assert prepared.meshes.pending() == (name,)
+        listed = dict(prepared.meshes.items())  # listing (femmech check) sizes nothing
+        assert name in listed
+    mesh = prepared.meshes[name]
+    assert prepared.meshes.pending() == ()
+    np.testing.assert_array_equal(mesh.points, reference.points)
+    for kind, cells in reference.cells.items():
+        np.testing.assert_array_equal(mesh.cells[kind], cells)

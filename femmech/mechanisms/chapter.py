@@ -34,6 +34,7 @@ from femmech.mechanisms.motion_laws import (
     modified_sine,
     polynomial_345,
 )
+from femmech.mechanisms.registry import MechanismType, register
 from femmech.mechanisms.symbolic import (
     Damper,
     Load,
@@ -110,6 +111,11 @@ def table_5_1_case(case: int) -> Mechanism:
                      labels=coordinate_labels(f"table_5_1_case({case})"))
 
 
+register(MechanismType("table_5_1_case", table_5_1_case,
+                      lambda options: f"table_5_1_case({options.get('case')})",
+                      tuple(f"table_5_1_case({case})" for case in (1, 2, 3, 4))))
+
+
 def _table_5_1_case_4() -> Mechanism:
     theta, q1, q2 = _symbols("theta q1 q2")
     U = position_function("U")
@@ -171,6 +177,13 @@ def processing_machine(kinematic_drive: bool = False) -> Mechanism:
     M0 = sympy.Symbol("M0", real=True)
     return Mechanism(q, elements + (Load(M0, q[0]),), name="processing machine",
                      labels=coordinate_labels("processing_machine()"))
+
+
+register(MechanismType(
+    "processing_machine", processing_machine,
+    lambda options: "processing_machine(kinematic_drive=True)"
+    if options.get("kinematic_drive") else "processing_machine()",
+    ("processing_machine()", "processing_machine(kinematic_drive=True)")))
 
 
 def processing_machine_mixed() -> Mechanism:
@@ -258,6 +271,9 @@ def mobile_crane() -> Mechanism:
                 Potential(g * (m2 * q1 + m3 * r3[1] + m5 * r5[1])))
     return Mechanism((q1, q2, q3, q4), elements, drives=(q4,), name="mobile crane",
                      labels=coordinate_labels("mobile_crane()"))
+
+
+register(MechanismType("mobile_crane", mobile_crane))
 
 
 def mobile_crane_parameters() -> dict[str, float]:

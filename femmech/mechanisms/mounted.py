@@ -29,6 +29,7 @@ from __future__ import annotations
 import sympy
 
 from femmech.mechanisms.catalogue import coordinate_labels
+from femmech.mechanisms.registry import MechanismType, register
 from femmech.mechanisms.symbolic import (
     Damper,
     Load,
@@ -90,6 +91,9 @@ def cam_follower(U: str = "U", m: str = "m", c: str = "c", c_return: str = "c_r"
                      labels=coordinate_labels("cam_follower()"))
 
 
+register(MechanismType("cam_follower", cam_follower))
+
+
 def slider_crank(m: str = "m2", c: str = "c2", J: str = "J1", c_t: str = "c1",
                  b: str = "b2", b_t: str = "b1", F: str = "F2",
                  name: str = "slider-crank") -> Mechanism:
@@ -139,3 +143,6 @@ def slider_crank(m: str = "m2", c: str = "c2", J: str = "J1", c_t: str = "c1",
                 Damper(bt, qt), Damper(b_, q), Load(-F_, x))
     return Mechanism((qt, ub, vb, vg, q, theta), elements, drives=(theta,), name=name,
                      labels=coordinate_labels("slider_crank()"))
+
+
+register(MechanismType("slider_crank", slider_crank))

@@ -36,7 +36,7 @@ _MOVED = {
     "GENERAL_OPTIONAL": "femmech.scene.load.GENERAL_OPTIONAL",
     "InterfaceSpec": "femmech.scene.load.InterfaceSpec",
     "ItemSpec": "femmech.scene.load.ItemSpec",
-    "MaterialSpec": "femmech.scene.load.MaterialSpec",
+    "MaterialSpec": "femmech.fe.materials.Material",
     "PartSpec": "femmech.scene.load.PartSpec",
     "REDUCTIONS": "femmech.scene.load.REDUCTIONS",
     "ReductionSpec": "femmech.scene.load.ReductionSpec",

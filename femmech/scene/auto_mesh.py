@@ -8,6 +8,10 @@ is turned into a frequency on the mesh itself: a coarse mesh gives a first (high
 estimate of the last mode's frequency, the mesh sized for it a better one, until the
 counts no longer change (at most :data:`MAX_ROUNDS` solves).
 
+Planning (:func:`femmech.scene.build.prepare`) never solves: it takes
+:func:`planned_mesh`, which is final where the wave rule alone sizes the part, and the
+solves of :func:`auto_mesh` run when the part's model is first needed.
+
 Shell parts are then *checked*: the wave rule sizes for the waves inside a panel and
 misses boundary layers (soft supports, clamped ends, folded corners), so the sized mesh's
 discretisation error over the band is estimated (:func:`femmech.analysis.discretisation.
@@ -115,6 +119,33 @@ def _coarse_params(kind: str, params: dict) -> dict:
     sides = [params[s] for s in _SHELL_SIDES[kind]]
     return {**params, "divisions": tuple(max(1, math.ceil(COARSE_ELEMENTS * s / max(sides)))
                                          for s in sides)}
+
+
+def planned_mesh(spec, beams: dict, shells: dict) -> tuple[Mesh, bool]:
+    """The mesh of a ``mesh = "auto"`` part as far as it is known without solving, and
+    whether it is final.
+
+    A beam part with a band given as ``f_max_hz`` is sized by the wave rule alone: its
+    mesh is final. Otherwise (a band given as ``n_modes``, or a shell part, whose sized
+    mesh is checked by an error estimate) sizing needs eigen solves, which planning
+    never runs: the mesh returned (the wave-rule mesh of a shell part, the coarse first
+    mesh of an ``n_modes`` band) has the part's groups and node sets for the checks of
+    planning, and :func:`auto_mesh` sizes the final one when the model is first needed.
+    ValueError as in :func:`auto_mesh`.
+    """
+    kind, value = spec.band
+    try:
+        if kind == "f_max_hz":
+            params = sized_params(spec.generator, spec.params, spec.target_error, value,
+                                  beams, shells)
+        else:
+            params = _coarse_params(spec.generator, spec.params)
+        final = kind == "f_max_hz" and spec.generator not in _SHELL_SIDES
+        return _built(spec.generator, params), final
+    except ValueError as exc:
+        raise ValueError(f"mesh = 'auto' (target_error {spec.target_error:g}, band"
+                         f" {kind} = {value:g}): {exc}; raise target_error or narrow the"
+                         " band") from None
 
 
 def auto_mesh(spec, beams: dict, shells: dict, model_of) -> Mesh:

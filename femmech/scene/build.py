@@ -2,7 +2,8 @@
 superelements, mechanism models and mounts.
 
 :func:`prepare` does everything that needs no FE computation (reads or generates the
-meshes, merges nearly coincident nodes where the scene asks, builds the mechanism models,
+meshes, leaving the sizing solves of ``mesh = "auto"`` parts to the first look-up,
+merges nearly coincident nodes where the scene asks, builds the mechanism models,
 checks every group name, node index and coordinate name, and collects the suspicious
 inputs of each part, :mod:`femmech.fe.checks`) and is what ``femmech check`` runs;
 :func:`part_model`, :func:`reduce_part` and :func:`machine_mounts` are the computing
@@ -20,7 +21,9 @@ import dataclasses
 import hashlib
 import json
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -32,7 +35,6 @@ from femmech.fe.constraints import InterpolatingLink, RigidLink, Support
 from femmech.fe.dofs import COMPONENTS
 from femmech.fe.generators import grid_frame, members_frame
 from femmech.fe.lumped import PointMass, Spring
-from femmech.fe.materials import Material
 from femmech.fe.mesh import Mesh
 from femmech.fe.mesh_io import read_mesh
 from femmech.fe.model import (
@@ -46,7 +48,7 @@ from femmech.fe.model import (
     node_indices,
 )
 from femmech.fe.sections import BeamSection
-from femmech.scene.auto_mesh import auto_mesh, generate
+from femmech.scene.auto_mesh import auto_mesh, generate, planned_mesh
 from femmech.scene.chain import check_chain
 from femmech.scene.load import PartSpec, Scene, fail
 from femmech.scene.mechanisms import check_drive_event, confined_module, mechanism_model
@@ -68,8 +70,9 @@ class Prepared:
     Attributes
     ----------
     scene : Scene
-    meshes : dict[str, Mesh]
-        Per part.
+    meshes : PartMeshes
+        Per part; a ``mesh = "auto"`` part that needs solves to be sized is sized on
+        first look-up.
     mechanisms : dict[str, RheolinearModel]
         Per mechanism.
     keys : dict[str, str]
@@ -111,7 +114,8 @@ def prepare(scene: Scene, allow_code: bool = False, code_root=None,
         says; its module paths are checked, its mechanisms are listed in
         :attr:`Prepared.unexecuted` and the checks that need their coordinates are skipped.
     """
-    meshes = {name: part_mesh(scene, part) for name, part in scene.parts.items()}
+    planned = {name: planned_part_mesh(scene, part) for name, part in scene.parts.items()}
+    meshes = {name: mesh for name, (mesh, _) in planned.items()}
     for name, part in scene.parts.items():
         check_part(scene, part, meshes[name])
     coded = [spec for spec in scene.mechanisms.values() if spec.module is not None]
@@ -137,7 +141,10 @@ def prepare(scene: Scene, allow_code: bool = False, code_root=None,
                 for name, part in scene.parts.items()}
     unexecuted = tuple(name for name in scene.mechanisms if name not in models)
     chain = check_chain(scene.chain, scene.file) if scene.chain is not None else None
-    return Prepared(scene, meshes, models, keys, findings, unexecuted, chain)
+    pending = {name: partial(part_mesh, scene, scene.parts[name])
+               for name, (_, final) in planned.items() if not final}
+    return Prepared(scene, PartMeshes(meshes, pending), models, keys, findings, unexecuted,
+                    chain)
 
 
 def finding_lines(prepared: Prepared) -> list[str]:
@@ -146,9 +153,56 @@ def finding_lines(prepared: Prepared) -> list[str]:
             for name, found in prepared.findings.items() for f in found]
 
 
+class PartMeshes(Mapping):
+    """Part name → :class:`~femmech.fe.mesh.Mesh`; a ``mesh = "auto"`` part whose sizing
+    needs eigen solves is sized when its mesh is first looked up (planning never solves).
+
+    Iterating (``items()``, ``values()``) does not size: it gives each pending part's
+    planning mesh (:func:`femmech.scene.auto_mesh.planned_mesh`), so that listing the
+    parts (``femmech check``) costs no solve; ``meshes[name]`` gives the final mesh.
+    """
+
+    def __init__(self, meshes: dict, pending: dict):
+        self._meshes, self._pending = dict(meshes), dict(pending)
+
+    def __getitem__(self, name: str) -> Mesh:
+        if name in self._pending:
+            self._meshes[name] = self._pending.pop(name)()
+        return self._meshes[name]
+
+    def __iter__(self):
+        return iter(self._meshes)
+
+    def __len__(self) -> int:
+        return len(self._meshes)
+
+    def items(self):
+        """(name, mesh) pairs, pending parts with their planning mesh (no sizing)."""
+        return self._meshes.items()
+
+    def values(self):
+        """The meshes, pending parts with their planning mesh (no sizing)."""
+        return self._meshes.values()
+
+    def pending(self) -> tuple:
+        """Names of the parts still to be sized."""
+        return tuple(self._pending)
+
+
 def part_mesh(scene: Scene, part: PartSpec) -> Mesh:
     """The part's mesh: read from its file or generated; edge groups turned into nodes."""
+    return _part_mesh(scene, part, plan=False)[0]
+
+
+def planned_part_mesh(scene: Scene, part: PartSpec) -> tuple[Mesh, bool]:
+    """The part's mesh as far as known without solving, and whether it is final (see
+    :func:`femmech.scene.auto_mesh.planned_mesh`; meshes of files and given counts are)."""
+    return _part_mesh(scene, part, plan=True)
+
+
+def _part_mesh(scene: Scene, part: PartSpec, plan: bool) -> tuple[Mesh, bool]:
     spec = part.mesh
+    final = True
     for where, key, ref in _node_refs(scene, part) if spec.auto else ():
         if not isinstance(ref, str):  # node indices depend on the sized counts
             raise fail(scene, part.where, "mesh", f"with mesh = 'auto' give nodes by group"
@@ -164,8 +218,11 @@ def part_mesh(scene: Scene, part: PartSpec) -> Mesh:
             _check_memory(scene, spec, mesh_counts(mesh), "mesh")
         elif spec.auto:  # mesh = "auto": counts sized for the part's band
             args = _model_args(scene, part)
-            mesh = auto_mesh(spec, args["beams"], args["shells"] or {},
-                             lambda m: part_model(scene, part, m))
+            if plan:
+                mesh, final = planned_mesh(spec, args["beams"], args["shells"] or {})
+            else:
+                mesh = auto_mesh(spec, args["beams"], args["shells"] or {},
+                                 lambda m: part_model(scene, part, m))
         elif spec.generator in ("rectangular_plate", "box"):
             mesh = generate(spec.generator, spec.params)
         elif spec.generator == "grid_frame":
@@ -178,7 +235,7 @@ def part_mesh(scene: Scene, part: PartSpec) -> Mesh:
     except (ValueError, FileNotFoundError) as exc:
         key = "mesh" if spec.file is not None else None
         raise fail(scene, spec.where, key, str(exc)) from None
-    return mesh if spec.merge_tol is None else merged_mesh(scene, part, mesh)
+    return (mesh if spec.merge_tol is None else merged_mesh(scene, part, mesh)), final
 
 
 _COUNT_KEYS = {"grid_frame": "subdivisions", "members": "members",
@@ -363,8 +420,7 @@ def part_findings(scene: Scene, part: PartSpec, mesh: Mesh) -> tuple:
 
 def _model_args(scene: Scene, part: PartSpec) -> dict:
     """Keyword arguments of :func:`femmech.build_model` for the part (without the mesh)."""
-    mats = {n: Material(E=m.E, rho=m.rho, nu=m.nu, G=m.G, name=n)
-            for n, m in scene.materials.items()}
+    mats = scene.materials
     beams, shells, solids = {}, {}, {}
     for s in part.sections:
         section = _section(s)

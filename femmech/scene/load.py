@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from femmech.errors import SceneError
+from femmech.fe.materials import Material
 from femmech.scene.analyses import MAX_MODES, Analyses, read_analyses
 from femmech.scene.chain import chain_analyses, read_chain, read_synthesis
 from femmech.scene.mesh import MeshSpec, read_mesh_spec, resolve_auto_band
@@ -32,6 +33,7 @@ from femmech.scene.reader import (
     check_limits,
     file_path,
     one_line,
+    relocate,
     show,
 )
 from femmech.scene.units import (
@@ -67,17 +69,6 @@ _DIMENSION_KEYS = tuple(dict.fromkeys(
 _PART_KEYS = ("mesh", "generator", "edge_node_groups", "merge_nodes", "sections", "shells",
               "solids", "supports", "masses", "springs", "rigid_links", "interpolating_links",
               "reduction", "target_error", "f_max_hz")
-@dataclass(frozen=True)
-class MaterialSpec:
-    """Isotropic material: E (Pa), rho (kg/m³), nu or G (Pa)."""
-
-    name: str
-    E: float
-    rho: float
-    nu: float | None = None
-    G: float | None = None
-
-
 @dataclass(frozen=True)
 class SectionSpec:
     """Beam property of a cell group: shape, dimensions (m or m², m⁴), material name."""
@@ -173,7 +164,7 @@ class Scene:
         Name of the scene file (for messages), ``"<dict>"`` when built from a dict.
     base_dir : Path
         Folder against which relative file names are resolved.
-    materials : dict[str, MaterialSpec]
+    materials : dict[str, femmech.fe.materials.Material]
     parts : dict[str, PartSpec]
     mechanisms : dict[str, femmech.scene.machine.MechanismSpec]
     mounts : tuple of femmech.scene.machine.MountSpec
@@ -246,17 +237,14 @@ def load_scene(path) -> Scene:
     return Scene.from_dict(data, path.parent, name)
 
 
-def _material(name: str, r: Reader) -> MaterialSpec:
+def _material(name: str, r: Reader) -> Material:
+    """The library's Material; its checks (E, rho, exactly one of nu and G, their ranges)
+    are located at the key they name."""
     r.expect("E", "rho", "nu", "G")
-    E = r.number("E", PRESSURE, positive=True)
-    rho = r.number("rho", DENSITY, non_negative=True)
-    nu = r.number("nu", DIMENSIONLESS, None)
-    G = r.number("G", PRESSURE, None, positive=True)
-    if (nu is None) == (G is None):
-        raise r.error(None, "give exactly one of nu and G")
-    if nu is not None and not -1.0 < nu < 0.5:
-        raise r.error("nu", f"expected a Poisson ratio in (-1, 0.5), got {nu}")
-    return MaterialSpec(name, E, rho, nu, G)
+    values = {"E": r.number("E", PRESSURE), "rho": r.number("rho", DENSITY),
+              "nu": r.number("nu", DIMENSIONLESS, None), "G": r.number("G", PRESSURE, None)}
+    with relocate(r, values, prefix=f"material {name!r}: "):
+        return Material(**values, name=name)
 
 
 def _material_name(r: Reader, materials: dict) -> str:
@@ -449,3 +437,10 @@ def fail(scene: Scene, where: str, key: str | None, message: str,
     """A SceneError (or its subclass ``error``) at ``[where] key`` of the scene file."""
     place = f"[{where}]" + (f" {key}" if key else "")
     return error(f"{scene.file}: {place}: {message}".replace("\n", " "))
+
+
+def __getattr__(name: str):
+    """Names this module had before the scene read straight into library objects."""
+    from femmech.deprecation import moved
+
+    return moved(__name__, name, {"MaterialSpec": "femmech.fe.materials.Material"})

@@ -1,6 +1,7 @@
 """Scene tables ``[mechanisms.<name>]`` and ``[[mounts]]``: mechanism models and attachments.
 
-A mechanism is a built-in model of :mod:`femmech.mechanisms` (:data:`BUILTIN_MODELS`) or a
+A mechanism is a built-in model of :mod:`femmech.mechanisms` (a registered type,
+:data:`femmech.mechanisms.registry.MECHANISM_TYPES`) or a
 function in a user Python module (``module = "my_mech.py"``, ``function = "build"``)
 returning a symbolic :class:`~femmech.mechanisms.Mechanism` (or a ready
 ``RheolinearModel`` or ``LagrangeModel``), with parameter values (SI or unit strings) and
@@ -20,16 +21,11 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import femmech.mechanisms  # noqa: F401  (its factory modules register the types)
 from femmech.fe.dofs import COMPONENTS
-from femmech.mechanisms import (
-    cam_follower,
-    mobile_crane,
-    processing_machine,
-    slider_crank,
-    table_5_1_case,
-)
-from femmech.mechanisms.catalogue import CATALOGUE, Entry
+from femmech.mechanisms.catalogue import Entry
 from femmech.mechanisms.motion_laws import LAWS
+from femmech.mechanisms.registry import MECHANISM_TYPES
 from femmech.scene.reader import Reader, file_path, show
 from femmech.scene.units import (
     ACCELERATION,
@@ -47,40 +43,11 @@ from femmech.scene.units import (
     Kind,
 )
 
-BUILTIN_MODELS = {"cam_follower": cam_follower, "slider_crank": slider_crank,
-                  "table_5_1_case": table_5_1_case, "processing_machine": processing_machine,
-                  "mobile_crane": mobile_crane}
-"""Built-in mechanism models by scene name → factory of :mod:`femmech.mechanisms`;
-``options`` are the factory's keyword arguments (checked against its signature). To offer
-a new mechanism type in scenes, add its factory here (and its roles to ``_ROLE_KINDS``; its
-coordinates and parameters to :data:`femmech.mechanisms.catalogue.CATALOGUE`)."""
-
-_ROLE_KINDS = {
-    "cam_follower": {"m": ("m", MASS), "c": ("c", STIFFNESS), "c_return": ("c_r", STIFFNESS),
-                     "b": ("b", DAMPING), "F": ("F", FORCE), "J": (None, INERTIA)},
-    "slider_crank": {"m": ("m2", MASS), "c": ("c2", STIFFNESS), "J": ("J1", INERTIA),
-                     "c_t": ("c1", ROT_STIFFNESS), "b": ("b2", DAMPING),
-                     "b_t": ("b1", ROT_DAMPING), "F": ("F2", FORCE)},
-}
-"""Per factory: option (parameter role) → (default parameter name, its dimension)."""
-
-_NAMED_KINDS = {
-    "slider_crank": {"r": LENGTH, "l": LENGTH, "e": LENGTH},
-    "table_5_1_case": {"J1": INERTIA, "c1": ROT_STIFFNESS, "b1": ROT_DAMPING, "m2": MASS,
-                       "m3": MASS, "c2": STIFFNESS, "c3": STIFFNESS, "b2": DAMPING,
-                       "b3": DAMPING, "F2": FORCE, "F3": FORCE},
-    "processing_machine": {"J0": INERTIA, "J1": INERTIA, "J2": INERTIA, "m1": MASS, "m2": MASS,
-                           "cT1": ROT_STIFFNESS, "cT2": ROT_STIFFNESS, "c3": STIFFNESS,
-                           "c4": STIFFNESS, "c6": STIFFNESS, "c7": STIFFNESS,
-                           "bT1": ROT_DAMPING, "bT2": ROT_DAMPING, "b3": DAMPING, "b4": DAMPING,
-                           "F1": FORCE, "F2": FORCE, "M0": MOMENT},
-    "mobile_crane": {"m2": MASS, "m3": MASS, "m5": MASS, "JS2": INERTIA, "JS3": INERTIA,
-                     "JS5": INERTIA, "x23": LENGTH, "xi23": LENGTH, "eta23": LENGTH,
-                     "rS3": LENGTH, "rS5": LENGTH, "r24": LENGTH, "r34": LENGTH,
-                     "r25": LENGTH, "alpha": ANGLE, "gamma": ANGLE, "c": STIFFNESS,
-                     "l1": LENGTH, "l2": LENGTH, "g": ACCELERATION},
-}
-"""Dimensions of parameters with fixed names (others accept any unit, converted to SI)."""
+BUILTIN_MODELS = {name: kind.factory for name, kind in MECHANISM_TYPES.items()}
+"""Built-in mechanism models by scene name → factory of :mod:`femmech.mechanisms`, as
+registered (:data:`femmech.mechanisms.registry.MECHANISM_TYPES`); ``options`` are the
+factory's keyword arguments (checked against its signature). A new mechanism type joins
+scenes by its registration next to its factory."""
 
 FORMS = ("rheolinear", "second_kind")
 """Equations a scene builds for a mechanism (``form``): ``rheolinear`` (linearised about
@@ -88,25 +55,22 @@ the programmed drive motion, :func:`femmech.mechanisms.rheolinear`; for mounts a
 sweeps; the default) or ``second_kind`` (the nonlinear Lagrange equations of the 2nd kind
 with prescribed drives, :func:`femmech.mechanisms.second_kind`; for drive events)."""
 
-_UNIT_KINDS = {"m": LENGTH, "rad": ANGLE, "N": FORCE, "N·m": MOMENT}
+UNIT_KINDS = {"m": LENGTH, "rad": ANGLE, "N": FORCE, "N·m": MOMENT, "kg": MASS,
+               "kg·m²": INERTIA, "N/m": STIFFNESS, "N·m/rad": ROT_STIFFNESS,
+               "N·s/m": DAMPING, "N·m·s/rad": ROT_DAMPING, "m/s²": ACCELERATION}
+"""Dimension of each SI unit the catalogue gives a built-in parameter or quantity."""
 
 
 def catalogue_entry(model: str | None, options: dict) -> Entry | None:
     """The :data:`~femmech.mechanisms.catalogue.CATALOGUE` entry of a built-in ``model``
     with its factory ``options`` (None for user modules)."""
-    if model == "table_5_1_case":
-        call = f"table_5_1_case({options.get('case')})"
-    elif model == "processing_machine" and options.get("kinematic_drive"):
-        call = "processing_machine(kinematic_drive=True)"
-    else:
-        call = f"{model}()"
-    return CATALOGUE.get(call)
+    kind = MECHANISM_TYPES.get(model)
+    return kind.entry(options) if kind is not None else None
 
 
-QUANTITIES = {model: {c.name: (c.meaning, _UNIT_KINDS.get(c.unit))
-                      for c in entry.coordinates + entry.quantities}
-              for model, entry in ((m, catalogue_entry(m, {"case": 1, "kinematic_drive": True}))
-                                   for m in BUILTIN_MODELS)}
+QUANTITIES = {model: {c.name: (c.meaning, UNIT_KINDS.get(c.unit))
+                      for c in kind.quantities({"case": 1, "kinematic_drive": True})}
+              for model, kind in MECHANISM_TYPES.items()}
 """Per built-in model (its default options; ``table_5_1_case``: case 1): quantity → (what
 it is physically, its dimension), from :data:`femmech.mechanisms.catalogue.CATALOGUE`.
 Quantities are coordinate names, ``"force <drive>"`` (the force a drive supplies) and
@@ -150,7 +114,7 @@ def describe_quantity(spec: MechanismSpec, name: str) -> tuple[str, Kind | None]
     raw name in brackets: :func:`femmech.mechanisms.catalogue.readable`."""
     entry = catalogue_entry(spec.model, spec.options)
     found = entry.coordinate(name) if entry is not None else None
-    return (found.meaning, _UNIT_KINDS.get(found.unit)) if found else (name, None)
+    return (found.meaning, UNIT_KINDS.get(found.unit)) if found else (name, None)
 
 
 @dataclass(frozen=True)
@@ -179,13 +143,12 @@ class MountSpec:
 
 
 def parameter_kinds(spec: MechanismSpec) -> dict:
-    """Parameter name → expected dimension for a built-in model (empty for user modules)."""
-    kinds = dict(_NAMED_KINDS.get(spec.model, {}))
-    for role, (default, kind) in _ROLE_KINDS.get(spec.model, {}).items():
-        name = spec.options.get(role, default)
-        if isinstance(name, str):
-            kinds[name] = kind
-    return kinds
+    """Parameter name → expected dimension for a built-in model (empty for user modules):
+    the registered type's parameters (:meth:`femmech.mechanisms.registry.MechanismType.
+    parameter_units`) under the names its options give them."""
+    kind = MECHANISM_TYPES.get(spec.model)
+    units = kind.parameter_units(spec.options) if kind is not None else {}
+    return {name: UNIT_KINDS[unit] for name, unit in units.items()}
 
 
 def read_mechanisms(root: Reader, base: Path) -> dict:

@@ -17,6 +17,7 @@ from __future__ import annotations
 import difflib
 import os
 import re
+from contextlib import contextmanager
 from pathlib import Path
 
 from femmech.errors import SceneError
@@ -315,3 +316,19 @@ class Reader:
             raise self.error(key, f"expected a table of named tables, got {show(value)}")
         return {name: self.child(f"{key}.{key_text(name)}", item)
                 for name, item in value.items()}
+
+
+@contextmanager
+def relocate(r: Reader, keys, prefix: str = ""):
+    """Re-raise the library's ValueError or TypeError in the block as a SceneError at
+    ``[table] key``: the first of ``keys`` the message names as its argument (``"...: E
+    must ..."``, ``"E = ... is outside"``), else at the table; ``prefix`` (the library's
+    own naming of the item, e.g. ``"material 'steel': "``) is dropped from the message,
+    which the table's location replaces."""
+    try:
+        yield
+    except (ValueError, TypeError) as exc:
+        message = str(exc).removeprefix(prefix)
+        key = next((k for k in keys if re.match(rf"{re.escape(k)}\b", message)),
+                   None)
+        raise r.error(key, message) from None

@@ -1,6 +1,7 @@
 """Lazily built objects of one scene run: FE models, superelements, coupled machines.
 
-A :class:`Workshop` is an explicit memo kept for one run (:mod:`femmech.scene.run`): a
+A :class:`Workshop` is an explicit memo kept for one run (:mod:`femmech.scene.run`): the
+mesh of a ``mesh = "auto"`` part that needs solves to be sized is sized here, a
 part's FE model is assembled only when an analysis or a cache miss needs it, its
 reduction is loaded from the cache when the key matches (:mod:`femmech.scene.cache`), and
 the unreduced coupled machine is built only for the full-versus-reduced check. The
@@ -84,6 +85,11 @@ class Workshop:
     def model(self, part: str) -> FEModel:
         """The part's assembled FE model (assembled once)."""
         if part not in self.models:
+            if part in self.prepared.meshes.pending():  # mesh = "auto": sized now
+                with self.timed(f"mesh sizing {part}"):
+                    mesh = self.prepared.meshes[part]
+                self.log(f"sized the mesh of part {part!r} (mesh = 'auto'):"
+                         f" {mesh.n_nodes} nodes")
             with self.timed(f"assembly {part}"):
                 spec = self.scene.parts[part]
                 self.models[part] = part_model(self.scene, spec, self.prepared.meshes[part])
