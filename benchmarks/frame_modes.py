@@ -241,7 +241,7 @@ def solve(model):
     row = {}
     targets = [(femmech.solve.eigen, "inertia_below", "sturm"),
                (femmech.solve.eigen, "factorize", "factor"),
-               (femmech.solve.eigen, "_arpack", "arpack"),  # bands
+               (femmech.solve.eigen, "arpack", "arpack"),  # bands
                (femmech.solve.lanczos, "arpack", "arpack"),  # where block Lanczos gives up
                (femmech.solve.lanczos, "block_lanczos", "arpack")]  # lowest modes
     with peak_memory(row, "eigen_peak_mb"), timer.patched(targets):

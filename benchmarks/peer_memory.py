@@ -69,7 +69,7 @@ def child(nx: int, ny: int, nz: int) -> dict:
                 label[0] = before
         setattr(module, name, wrapped)
     for module, name, tag in [(cm, "factorize_interior", "K_ii factorisation"),
-                              (eigen, "_lowest_pairs", "Lanczos (fixed-interface modes)"),
+                              (eigen, "lowest_pairs", "Lanczos (fixed-interface modes)"),
                               (eigen, "inertia_below", "Sturm check"),
                               (cm, "residual_modes", "residual vectors"),
                               (cm, "_project", "projection")]:

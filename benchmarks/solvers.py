@@ -146,7 +146,7 @@ def eigen_solve(model, name, check=True):
     counter = [0, 0]  # solve calls, vectors solved
     original = femmech.solve.eigen.factorize
     targets = [(femmech.solve.eigen, "inertia_below", "sturm"),
-               (femmech.solve.eigen, "_lowest_pairs", "arpack")]
+               (femmech.solve.eigen, "lowest_pairs", "arpack")]
     femmech.solve.eigen.factorize = _counting_factorize(counter, original)
     try:
         with timer.patched(targets + [(femmech.solve.eigen, "factorize", "factor")]), \

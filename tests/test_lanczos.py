@@ -296,7 +296,7 @@ def test_small_models_take_arpack_for_exactly_the_wanted_pairs(monkeypatch):
     K, M = model.K_free, model.M_free
     calls = []
     monkeypatch.setattr(lanczos, "lowest_pairs", _counting(lanczos.lowest_pairs, calls))
-    monkeypatch.setattr(eigen, "_lowest_pairs", lanczos.lowest_pairs)
+    monkeypatch.setattr(eigen, "lowest_pairs", lanczos.lowest_pairs)
     first = solve_symmetric(K, M, n_modes=5)  # the 5th is a double: the cluster comes back
     assert calls == []  # ARPACK only
     assert first.omega2.size == first.sturm_count == 6
@@ -326,7 +326,7 @@ def test_without_a_count_the_guarded_path_runs(monkeypatch):
     K, M = model.K_free, model.M_free
     monkeypatch.setattr(eigen, "inertia_below", lambda *args, **kw: None)
     calls = []
-    monkeypatch.setattr(eigen, "_lowest_pairs", _counting(lanczos.lowest_pairs, calls))
+    monkeypatch.setattr(eigen, "lowest_pairs", _counting(lanczos.lowest_pairs, calls))
     result = solve_symmetric(K, M, n_modes=3)
     assert len(calls) == 1
     assert result.sturm_count is None

@@ -7,6 +7,8 @@ One job per module:
   fractions.
 * :mod:`.sweep`: quasi-eigenfrequencies and quasi-modes of a coupled machine over the
   drive angle.
+* :mod:`.tracking`: mode tracking shared by the angle and chain sweeps (MAC, clusters,
+  branch assignment).
 * :mod:`.reference`: full (unreduced) coupled reference solves, reduced versus full.
 * :mod:`.magnus`: monodromy matrices by a fourth-order Magnus integrator with step
   doubling.

@@ -48,12 +48,12 @@ class _Impedance:
 
 
 def chain_impedance(chain, phi, Omega, Omega_dot) -> _Impedance:
-    from femmech.chain.transfer import _internal_modes
+    from femmech.chain.transfer import internal_modes
 
     Mu, Cu = symmetric_unit_matrices(chain, phi, Omega, Omega_dot)
     a = chain.attach
     inner = np.array([i for i in range(chain.m) if i != a], dtype=int)
-    mu, _, alpha, beta = _internal_modes(Mu, Cu, a, inner)
+    mu, _, alpha, beta = internal_modes(Mu, Cu, a, inner)
     residue = np.abs(alpha - mu * beta)
     size = float((np.abs(alpha) + np.abs(mu * beta)).max(initial=0.0))
     coupled = residue > 1e-12 * max(size, 1e-300)

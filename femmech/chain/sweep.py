@@ -21,15 +21,17 @@ import scipy.linalg as sla
 
 from femmech.analysis.sweep import Sweep
 from femmech.analysis.tracking import assign_branches, clusters, cuts_cluster
+from femmech.chain import transfer
 from femmech.chain.results import ChainModes
 from femmech.chain.transfer import assembled_modes, transfer_modes
 
 METHODS = ("transfer", "assembled", "cyclic", "continuum")
 """Methods :func:`chain_sweep` knows."""
 
-REPEATED_RTOL = 1e-9
+REPEATED_RTOL = transfer.REPEATED_RTOL
 """Frequencies within this relative spread are one repeated root (its basis is aligned
-to the branches' previous vectors); the roots are accurate to ~1e-12."""
+to the branches' previous vectors); the same spread as the transfer solver's
+(:data:`femmech.chain.transfer.REPEATED_RTOL`), whose roots are accurate to ~1e-12."""
 
 
 def chain_sweep(chain, phi, n_modes: int, method: str = "transfer",

@@ -53,6 +53,7 @@ from scipy.optimize import minimize
 from scipy.special import logsumexp
 from scipy.stats import qmc
 
+from femmech.analysis import tracking
 from femmech.solve import dense, threads, tolerances
 
 DEFAULT_ANGLES = 72
@@ -62,9 +63,10 @@ KS_RHO = 200.0
 """Sharpness ρ of the KS aggregate, per unit relative distance: terms 1/ρ = 0.5 % farther
 from a band than the closest one weigh e⁻¹ as much."""
 
-CLUSTER_RTOL = 1e-3
+CLUSTER_RTOL = tracking.CLUSTER_RTOL
 """Frequencies this close (relative) to the last one kept by ``n_modes`` are kept too,
-so a cluster of repeated eigenvalues is never cut (its aggregate is smooth only whole)."""
+so a cluster of repeated eigenvalues is never cut (its aggregate is smooth only whole);
+the cluster width of mode tracking (:data:`femmech.analysis.tracking.CLUSTER_RTOL`)."""
 
 FD_STEP = 1e-6
 """Step in the normalised parameter (range [0, 1]) of the matrix differences."""

@@ -161,7 +161,7 @@ def _frozen(chain, phi: float, Omega: float = 0.0) -> _Frozen:
     on_free = free[chain.unit_node]
     a = chain.attach
     inner = np.array([i for i in range(chain.m) if i != a], dtype=int)
-    mu, Phi, alpha, beta = _internal_modes(Mu, Cu, a, inner)
+    mu, Phi, alpha, beta = internal_modes(Mu, Cu, a, inner)
     M, _, C = chain.sparse_matrices(float(phi), Omega)
     J = chain.node_inertia[free]
     maa, caa = Mu[:, a, a], Cu[:, a, a]
@@ -203,7 +203,7 @@ def _check_symmetric(Cu, Omega) -> None:
                          " needs a symmetric C; use Ω = 0 or assembled_modes")
 
 
-def _internal_modes(Mu, Cu, a, inner):
+def internal_modes(Mu, Cu, a, inner):
     """Internal eigenpairs of every unit with its attach coordinate fixed: μ (n_units,
     m-1), Φ (n_units, m-1, m-1) M_ii-normalised, and the modal couplings α = Φᵀ C_ia,
     β = Φᵀ M_ia."""

@@ -17,6 +17,7 @@ C stiffness, F force.
 * :mod:`.chapter`: built-in models of the seed chapter (Table 5.1, 5.2.3.1, 5.2.3.2).
 * :mod:`.catalogue`: what the built-in models' coordinates and parameters mean (units,
   signs; the readable labels of tables and plots, docs/mechanisms.md).
+* :mod:`.registry`: the mechanism types a scene names, registered next to their factories.
 
 Imports only its own modules.
 """

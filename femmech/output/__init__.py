@@ -23,7 +23,11 @@ neither.
   engineering numbers (value, unit, significant digits).
 * :mod:`.animate`: a mode shape swinging through a period (GIF); :mod:`.series`: result
   series for ParaView; :mod:`.campbell`: Campbell diagrams of chains;
-  :mod:`.local_axes`: the local axes of beam elements (PNG).
+  :mod:`.local_axes`: the local axes of beam elements (PNG); :mod:`.chain_plots`: a chain
+  sweep by method (PNG).
+* :mod:`.response_plots`: forced-response histories of a scene (PNG);
+  :mod:`.speed_error`: reduced-versus-full error over speed (PNG); :mod:`.csv_rows`: CSV
+  tables written atomically.
 * :mod:`.folder`: one run, one output folder (staging folder and manifest);
   :mod:`.folder_swap`: its crash-safe swap (run lock, journal, recovery of killed runs).
 

@@ -31,10 +31,11 @@ from femmech.fe.dofs import COMPONENTS, DOF_PER_NODE, dof_label
 from femmech.fe.model import FEModel
 from femmech.reduction.products import plus_sparse, product_phase, symmetric_product
 from femmech.reduction.superelement import Superelement
+from femmech.solve import tolerances
 from femmech.solve.pencil import factorize
 from femmech.solve.sturm import confirm_indices
 
-REAL_RTOL = 1e-9
+REAL_RTOL = tolerances.REAL_RTOL
 """Eigenvalues with ``|Im λ| <= REAL_RTOL |λ|`` and vectors with imaginary parts below
 ``REAL_RTOL`` times their largest entry count as real (LAPACK round-off)."""
 

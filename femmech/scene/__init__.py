@@ -1,4 +1,4 @@
-"""Stage 9, scene files: a machine and the analyses wanted, in one TOML file, run end to end.
+"""Scene files: a machine and the analyses wanted, in one TOML file, run end to end.
 
 One direction, no circles: quantities with units (:mod:`.units`) → strict reading of a
 table (:mod:`.reader`) → the tables of parts' meshes (:mod:`.mesh`), mechanisms and
@@ -6,8 +6,9 @@ mounts (:mod:`.machine`) and analyses (:mod:`.analyses`) → the validated
 :class:`~femmech.scene.load.Scene` (:mod:`.load`) → mechanism models (:mod:`.mechanisms`)
 → meshes, FE models, superelements and mounts with every reference checked
 (:mod:`.build`) → cached reductions (:mod:`.cache`) → lazily built objects of one run
-(:mod:`.workshop`) → the analyses' files and report sections (:mod:`.tasks`) → the run
-into one output folder (:mod:`.run`). Beside them: generated meshes sized for a band
+(:mod:`.workshop`) → the analyses' files and report sections, one module per kind in
+:mod:`.kinds` and listed by :mod:`.registry` (old path: :mod:`.tasks`) → the run into one
+output folder (:mod:`.run`). Beside them: generated meshes sized for a band
 (:mod:`.auto_mesh`), the memory a part needs before it is built (:mod:`.memory`), the
 cache's folder (:mod:`.cache_folder`), the chain tables (:mod:`.chain`) and the report
 sections describing a run (:mod:`.summary`).

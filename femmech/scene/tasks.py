@@ -10,19 +10,18 @@ def __getattr__(name: str):
     """The names this module had, from their new places."""
     from femmech.deprecation import moved
 
-    kinds = "femmech.scene.kinds."
     return moved(__name__, name, {
         "TASKS": "femmech.scene.registry.RUNNERS",
-        "matched_full_modes": kinds + "check.matched_full_modes",
-        "run_campbell": kinds + "campbell.run",
-        "run_chain_sweep": kinds + "chain_sweep.run",
-        "run_check": kinds + "check.run",
-        "run_drive_event": kinds + "drive_event.run",
-        "run_modes": kinds + "modes.run",
-        "run_response": kinds + "response.run",
-        "run_stability": kinds + "stability.run",
-        "run_sweep": kinds + "sweep.run",
-        "run_synthesis": kinds + "synthesis.run",
+        "matched_full_modes": "femmech.scene.kinds.check.matched_full_modes",
+        "run_campbell": "femmech.scene.kinds.campbell.run",
+        "run_chain_sweep": "femmech.scene.kinds.chain_sweep.run",
+        "run_check": "femmech.scene.kinds.check.run",
+        "run_drive_event": "femmech.scene.kinds.drive_event.run",
+        "run_modes": "femmech.scene.kinds.modes.run",
+        "run_response": "femmech.scene.kinds.response.run",
+        "run_stability": "femmech.scene.kinds.stability.run",
+        "run_sweep": "femmech.scene.kinds.sweep.run",
+        "run_synthesis": "femmech.scene.kinds.synthesis.run",
         "summary_section": "femmech.scene.summary.summary_section",
     }, removed={
         "RPM": "an internal factor; use femmech.output.charts.SPEED_UNITS['rpm']",

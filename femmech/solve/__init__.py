@@ -11,7 +11,9 @@ Modules, one job each:
   factorisation of ``K - σ M``;
 * :mod:`.residuals`: mass normalisation of modes, residuals and their limits;
 * :mod:`.sturm`: Sturm-sequence (inertia) counts and cluster completion;
-* :mod:`.dense`: the dense LAPACK path for small systems;
+* :mod:`.dense`: the one dense pencil solver (symmetric, unsymmetric, damped; one pencil
+  or a stack of angles);
+* :mod:`.tolerances`: the tolerances every solve path shares (symmetry, zero, real, cut-over);
 * :mod:`.arpack`: shift-invert ARPACK with deflation (bands, fallback);
 * :mod:`.lanczos`: femmech's shift-invert block Lanczos for the lowest modes;
 * :mod:`.eigen`: the driver :func:`~femmech.solve.eigen.solve_symmetric` and its result

@@ -13,7 +13,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from femmech.solve import threads
-from femmech.solve.pencil import _n_mass
+from femmech.solve.pencil import n_mass
 
 
 def arpack(K, M, k, sigma, lu, deflate=None, maxiter=None):
@@ -32,10 +32,10 @@ def arpack(K, M, k, sigma, lu, deflate=None, maxiter=None):
     ``scipy.sparse.linalg.ArpackNoConvergence`` is raised.
     """
     n = K.shape[0]
-    krylov = _n_mass(M) - (0 if deflate is None else deflate.shape[1])
+    krylov = n_mass(M) - (0 if deflate is None else deflate.shape[1])
     k = min(k, krylov - 1)
     if k < 1:
-        raise ValueError(f"no further finite eigenvalue: only {_n_mass(M)} of the {n} DOFs"
+        raise ValueError(f"no further finite eigenvalue: only {n_mass(M)} of the {n} DOFs"
                          " carry mass")
     ncv = min(n, max(2 * k + 1, 20), krylov)
     v0 = np.random.default_rng(12345).standard_normal(n)
@@ -70,4 +70,3 @@ def purify(X, omega2, sigma, M, solve):
     return solve(M @ X) * (omega2 - sigma)
 
 
-_arpack = arpack  # old name: femmech.solve.eigen imports it

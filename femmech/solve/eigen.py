@@ -26,17 +26,17 @@ from scipy.sparse.linalg import ArpackNoConvergence
 
 from femmech.errors import FemmechWarning
 from femmech.solve import direct, tolerances
-from femmech.solve.arpack import _arpack
+from femmech.solve.arpack import arpack
 from femmech.solve.dense import dense_symmetric
-from femmech.solve.lanczos import _FarShiftError, _lowest_pairs
-from femmech.solve.pencil import _n_mass, default_shift, eigenvalue_scale, factorize
+from femmech.solve.lanczos import FarShiftError, lowest_pairs
+from femmech.solve.pencil import default_shift, eigenvalue_scale, factorize, n_mass
 from femmech.solve.residuals import (
-    _residual_terms,
     normalize_modes,
     residual_limits,
     residual_message,
+    residual_terms,
 )
-from femmech.solve.sturm import _complete_cluster, _cut_above, inertia_below
+from femmech.solve.sturm import complete_cluster, cut_above, inertia_below
 
 MAX_DEFLATIONS = 10
 """Deflated Lanczos restarts allowed to complete a set that the Sturm count shows short."""
@@ -196,7 +196,7 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         in 1..n or above the number of DOFs with mass, a band or shift that is not finite.
     """
     n = K.shape[0]
-    _check_request(n, _n_mass(M), n_modes, band, sigma, factor, scale)
+    _check_request(n, n_mass(M), n_modes, band, sigma, factor, scale)
     scale = eigenvalue_scale(K, M) if scale is None else float(scale)
     shift = -1e-6 * scale if sigma is None else float(sigma)
     zero = RIGID_TOL * scale if rigid_tol is None else float(rigid_tol)
@@ -207,7 +207,7 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         wanted = None if band is not None else n_modes + max(4, n_modes // 5)
         omega2, X = dense_symmetric(K, M, wanted, sigma=shift)
         if wanted is not None and omega2.size == wanted and wanted < n and \
-                _complete_cluster(omega2, n_modes) == wanted:
+                complete_cluster(omega2, n_modes) == wanted:
             omega2, X = dense_symmetric(K, M, sigma=shift)  # a cluster fills the subset
         omega2, X = _select(omega2, X, n_modes, band)
         method = "dense"
@@ -223,7 +223,7 @@ def solve_symmetric(K, M, n_modes: int | None = None, band: tuple[float, float] 
         omega2, X, shift = _sparse_band(K, M, band, sigma, factor)
         method = "arpack"
     X = normalize_modes(X, M)
-    num, den = _residual_terms(K, M, omega2, X, 1e-6 * scale)
+    num, den = residual_terms(K, M, omega2, X, 1e-6 * scale)
     res = num / np.where(den > 0, den, 1.0)
     limits = residual_limits(K, X, den)
     message = residual_message(res, limits, omega2)
@@ -257,7 +257,7 @@ def sturm_verified(K, M, omega2: np.ndarray, scale: float | None = None) -> tupl
     """
     omega2 = np.sort(np.asarray(omega2, dtype=float))
     scale = eigenvalue_scale(K, M) if scale is None else float(scale)
-    cut = _cut_above(omega2[-1], scale)
+    cut = cut_above(omega2[-1], scale)
     below = inertia_below(K, M, cut)
     return (-1 if below is None else int(below)), int(np.count_nonzero(omega2 <= cut))
 
@@ -266,7 +266,7 @@ def _select(omega2, X, n_modes, band):
     if band is not None:
         keep = (omega2 >= band[0]) & (omega2 <= band[1])
         return omega2[keep], X[:, keep]
-    count = _complete_cluster(omega2, min(n_modes, len(omega2)))
+    count = complete_cluster(omega2, min(n_modes, len(omega2)))
     return omega2[:count], X[:, :count]
 
 
@@ -293,13 +293,13 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
     lu = factorize(K - sigma * M, definite=None if sigma < 0 else False) \
         if factor is None else factor
     guard = max(4, n_modes // 5)
-    limit = min(n - 2, _n_mass(M) - 1)  # below the Krylov dimension (and ARPACK's k < n - 1)
+    limit = min(n - 2, n_mass(M) - 1)  # below the Krylov dimension (and ARPACK's k < n - 1)
     guarded = True  # block Lanczos with guard pairs; False: ARPACK, the count guards
     if check and n < ARPACK_BELOW and n_modes + ARPACK_GUARD <= limit:
         try:
-            omega2, X = _arpack(K, M, n_modes + ARPACK_GUARD, sigma, lu,
+            omega2, X = arpack(K, M, n_modes + ARPACK_GUARD, sigma, lu,
                                 maxiter=ARPACK_MAXITER)
-            count, guarded = _complete_cluster(omega2, n_modes), False
+            count, guarded = complete_cluster(omega2, n_modes), False
         except ArpackNoConvergence:
             pass  # (a shift far from the wanted eigenvalues): block Lanczos
     if guarded:
@@ -311,14 +311,14 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
         # every computed eigenvalue up to the cut counts: where the cut (a relative 1e-6
         # above the last wanted one, or the absolute floor of the scale) passes further
         # computed ones, they are part of the verified set
-        cut = _cut_above(omega2[count - 1], scale)
+        cut = cut_above(omega2[count - 1], scale)
         inside = int(np.count_nonzero(omega2 <= cut))
         below = inertia_below(K, M, cut, like=lu)
         if below is None and not guarded:  # no count: the guards must see a cluster
             guarded = True
             omega2, X, count, sigma, lu, guard = _guarded_lanczos(K, M, n_modes, sigma, lu,
                                                                   movable, guard, limit)
-            cut = _cut_above(omega2[count - 1], scale)
+            cut = cut_above(omega2[count - 1], scale)
         if below is None:
             return omega2[:count], X[:, :count], None, cut, sigma, _algorithm(guarded)
         if below == inside:
@@ -330,8 +330,8 @@ def _sparse_lowest(K, M, n_modes, sigma, factor=None, check=True, scale=None,
         # found ones deflated, then count again (the cut moves down if lower ones appear)
         extra = min(below - inside + guard, n - 2 - inside)
         omega2, X = _merge(omega2[:inside], X[:, :inside],
-                           *_lowest_pairs(K, M, extra, sigma, lu, deflate=X[:, :inside]))
-        count = _complete_cluster(omega2, min(n_modes, omega2.size))
+                           *lowest_pairs(K, M, extra, sigma, lu, deflate=X[:, :inside]))
+        count = complete_cluster(omega2, min(n_modes, omega2.size))
     raise RuntimeError(f"Sturm check: eigenvalues below {cut:.6g} rad²/s² still missing after"
                        f" {MAX_DEFLATIONS} deflated restarts; try another sigma")
 
@@ -351,16 +351,16 @@ def _guarded_lanczos(K, M, n_modes, sigma, lu, movable, guard, limit):
     while True:
         k = min(n_modes + guard, limit)
         if k < n_modes:
-            raise ValueError(f"{n_modes} modes of a {n}-DOF system with {_n_mass(M)} DOFs with"
+            raise ValueError(f"{n_modes} modes of a {n}-DOF system with {n_mass(M)} DOFs with"
                              " mass: use the dense path (raise dense_below) or ask for fewer"
                              " modes")
         try:
-            omega2, X = _lowest_pairs(K, M, k, sigma, lu, n_wanted=n_modes, far_check=movable)
-        except _FarShiftError as far:
+            omega2, X = lowest_pairs(K, M, k, sigma, lu, n_wanted=n_modes, far_check=movable)
+        except FarShiftError as far:
             sigma, movable = far.shift, False  # (the same ordering: no new analysis)
             lu = lu.factorize_like(K - sigma * M, definite=None if sigma < 0 else False)
             continue
-        count = _complete_cluster(omega2, n_modes)
+        count = complete_cluster(omega2, n_modes)
         if count < k or k == limit:
             return omega2, X, count, sigma, lu, guard
         guard *= 2  # a cluster of repeated eigenvalues fills all computed modes
@@ -419,7 +419,7 @@ def _sparse_band(K, M, band, sigma, factor=None):
     omega2, X = np.empty(0), np.empty((n, 0))
     for _ in range(MAX_DEFLATIONS):
         k = min(count - omega2.size + 2, n - 2 - omega2.size)
-        omega2, X = _merge(omega2, X, *_arpack(K, M, k, shift, lu, deflate=X))
+        omega2, X = _merge(omega2, X, *arpack(K, M, k, shift, lu, deflate=X))
         keep = (omega2 >= lo) & (omega2 <= hi)
         omega2, X = omega2[keep], X[:, keep]
         if omega2.size >= count:

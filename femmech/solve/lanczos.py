@@ -22,7 +22,7 @@ import scipy.sparse as sp
 from femmech.errors import FemmechWarning
 from femmech.solve import threads
 from femmech.solve.arpack import arpack, purify
-from femmech.solve.pencil import _n_mass
+from femmech.solve.pencil import n_mass
 from femmech.solve.sturm import complete_cluster
 
 LANCZOS_TOL = 1e-12
@@ -174,10 +174,10 @@ class _BlockLanczos:
     def __init__(self, K, M, k, sigma, lu, deflate, block, tol, max_dim, seed, n_wanted):
         n = K.shape[0]
         n_defl = 0 if deflate is None else deflate.shape[1]
-        krylov = _n_mass(M) - n_defl
+        krylov = n_mass(M) - n_defl
         k = min(k, krylov)
         if k < 1:
-            raise ValueError(f"no further finite eigenvalue: only {_n_mass(M)} of the {n} DOFs"
+            raise ValueError(f"no further finite eigenvalue: only {n_mass(M)} of the {n} DOFs"
                              " carry mass")
         n_wanted = k if n_wanted is None else min(n_wanted, k)
         block = max(1, min(block, k))
@@ -518,5 +518,3 @@ class _BlockLanczos:
         return omega2, X
 
 
-_FarShiftError = FarShiftError  # old name: femmech.solve.eigen imports it
-_lowest_pairs = lowest_pairs  # old name: femmech.solve.eigen imports it

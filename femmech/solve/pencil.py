@@ -36,7 +36,7 @@ def default_shift(K, M, scale: float | None = None) -> float:
     return -1e-6 * (eigenvalue_scale(K, M) if scale is None else scale)
 
 
-def _n_mass(M) -> int:
+def n_mass(M) -> int:
     """DOFs with positive mass diagonal: an upper bound of rank(M) (M is semi-definite, so a
     zero diagonal entry is a zero row) and of the number of finite eigenvalues."""
     return int(np.count_nonzero(np.asarray(M.diagonal()) > 0))

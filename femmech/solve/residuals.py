@@ -99,4 +99,3 @@ def residual_message(residual, limits, omega2) -> str | None:
             + " (limit: 1e-6, or 100 times the residual's round-off level)")
 
 
-_residual_terms = residual_terms  # old name: femmech.solve.eigen imports it

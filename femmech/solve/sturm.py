@@ -169,5 +169,3 @@ def _common_point_groups(lower, upper, open_) -> list[np.ndarray]:
     return groups
 
 
-_complete_cluster = complete_cluster  # old name: femmech.solve.eigen imports it
-_cut_above = cut_above  # old name: femmech.solve.eigen imports it
