@@ -286,11 +286,9 @@ def simply_supported_beam(n=40, E=210e9):
         fm.Support("ends", "translations"), fm.Support(0, ["rx"])])
 
 
-def damped_cam_on_beam():
+def cam_with_dampers_on_beam():
     """Table 5.1 case 1 cam on the simply supported beam (``simply_supported_beam``), with
-    dampers on the shaft twist and follower (2 N m s/rad, 80 N s/m) and Rayleigh
-    damping of the frame (B₀ += 1.0 M₀ + 1e-5 K₀); the ``damped_cam_system`` fixture of
-    ``conftest.py``."""
+    dampers on the shaft twist and follower (2 N m s/rad, 80 N s/m); the frame undamped."""
     theta, q1, yg, q2 = sympy.symbols("theta q1 y_g q2")
     J1, m2, c1, c2, d1, d2 = sympy.symbols("J1 m2 c1 c2 d1 d2")
     x2 = yg + position_function("U")(theta + q1) + q2
@@ -298,8 +296,14 @@ def damped_cam_on_beam():
                      (RotaryInertia(J1, theta + q1), PointMass(m2, (x2,)), Spring(c1, q1),
                       Spring(c2, q2), Damper(d1, q1), Damper(d2, q2)), drives=(theta,))
     model = rheolinear(mech, {**PARAMS, "d1": 2.0, "d2": 80.0}, {"U": CAM})
-    system = couple(craig_bampton(simply_supported_beam(), "mid", n_modes=6),
-                    [Mount(model, (Attachment("y_g", 20, "uy"),), name="cam")])
+    return couple(craig_bampton(simply_supported_beam(), "mid", n_modes=6),
+                  [Mount(model, (Attachment("y_g", 20, "uy"),), name="cam")])
+
+
+def damped_cam_on_beam():
+    """:func:`cam_with_dampers_on_beam` with Rayleigh damping of the frame
+    (B₀ += 1.0 M₀ + 1e-5 K₀); the ``damped_cam_system`` fixture of ``conftest.py``."""
+    system = cam_with_dampers_on_beam()
     return dataclasses.replace(system, B0=system.B0 + 1.0 * system.M0 + 1e-5 * system.K0)
 
 

@@ -13,14 +13,13 @@ extrapolated.
 import numpy as np
 import pytest
 import scipy.linalg as sl
-from models import plate_cells
+from models import STEEL, mindlin_ssss, plate_cells
 
 import femmech as fm
 from femmech.analysis.discretisation import RATES, discretisation_error, match_modes
 from femmech.fe.refine import refined_model
 from femmech.fe.sections import rectangle
 
-STEEL = fm.Material(E=200e9, nu=0.3, rho=8000.0)
 FACTOR = 3.0  # the acceptance: estimate within a factor 3 of the truth
 
 
@@ -131,20 +130,11 @@ def plate_model(n, tri=False, t=0.01, kind=None):
 
 
 def mindlin_hz(m, n, t=0.01, k=5.0 / 6.0):
-    """Mindlin (1951) exact frequency (Hz) of mode (m, n) of the hard simply supported
-    square plate (tests/test_shell_verification.py::mindlin_ssss, which tends to Leissa's
-    Kirchhoff values λ = π² (m² + n²))."""
-    E, nu, rho = STEEL.E, STEEL.poisson_ratio, STEEL.rho
-    G, D = STEEL.shear_modulus, E * t ** 3 / (12 * (1 - nu ** 2))
-    al, be = m * np.pi, n * np.pi
-    k2, s = al ** 2 + be ** 2, k * G * t
-    K = np.array([[s * k2, s * al, s * be],
-                  [s * al, D / 2 * ((1 - nu) * k2 + (1 + nu) * al ** 2) + s,
-                   D / 2 * (1 + nu) * al * be],
-                  [s * be, D / 2 * (1 + nu) * al * be,
-                   D / 2 * ((1 - nu) * k2 + (1 + nu) * be ** 2) + s]])
-    return np.sqrt(sl.eigh(K, np.diag([rho * t, rho * t ** 3 / 12, rho * t ** 3 / 12]),
-                           eigvals_only=True)[0]) / (2 * np.pi)
+    """Mindlin (1951) exact frequency (Hz) of mode (m, n) of the hard simply supported unit
+    square plate of STEEL: the frequency parameter ``models.mindlin_ssss`` (which tends to
+    Leissa's Kirchhoff values λ = π² (m² + n²)) as ω = λ √(D / (ρ t)) for a = 1 m."""
+    D = STEEL.E * t ** 3 / (12 * (1 - STEEL.poisson_ratio ** 2))
+    return mindlin_ssss(m, n, t, 1.0, k) * np.sqrt(D / (STEEL.rho * t)) / (2 * np.pi)
 
 
 PLATE_TRUTH = np.sort([mindlin_hz(m, n) for m in range(1, 4) for n in range(1, 4)])[:6]

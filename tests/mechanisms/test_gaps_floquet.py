@@ -14,36 +14,16 @@ import dataclasses
 
 import numpy as np
 import pytest
-import sympy
-from models import CAM, PARAMS, simply_supported_beam
+from models import cam_with_dampers_on_beam
 
 from femmech.analysis.floquet import coupled_floquet, coupled_monodromy, floquet
 from femmech.analysis.response import rayleigh_damping
-from femmech.coupling import Attachment, Mount, couple
-from femmech.mechanisms import (
-    Damper,
-    Mechanism,
-    PointMass,
-    RotaryInertia,
-    Spring,
-    position_function,
-    rheolinear,
-)
-from femmech.reduction.component_modes import craig_bampton
 
 
 @pytest.fixture(scope="module")
 def undamped_frame():
     """The damped cam (dampers 2 N m s/rad and 80 N s/m) on the undamped beam."""
-    theta, q1, yg, q2 = sympy.symbols("theta q1 y_g q2")
-    J1, m2, c1, c2, d1, d2 = sympy.symbols("J1 m2 c1 c2 d1 d2")
-    x2 = yg + position_function("U")(theta + q1) + q2
-    mech = Mechanism((q1, yg, q2, theta),
-                     (RotaryInertia(J1, theta + q1), PointMass(m2, (x2,)), Spring(c1, q1),
-                      Spring(c2, q2), Damper(d1, q1), Damper(d2, q2)), drives=(theta,))
-    model = rheolinear(mech, {**PARAMS, "d1": 2.0, "d2": 80.0}, {"U": CAM})
-    return couple(craig_bampton(simply_supported_beam(), "mid", n_modes=6),
-                  [Mount(model, (Attachment("y_g", 20, "uy"),), name="cam")])
+    return cam_with_dampers_on_beam()
 
 
 def test_undamped_frame_is_refused_with_the_reason(undamped_frame):
