@@ -505,7 +505,7 @@ def test_repeated_bending_pairs(n_el):
         lam, X = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, 8])
     else:
         assert model.n_free > 400
-        assert result.method == "arpack"
+        assert result.method in ("arpack", "block-lanczos")  # the sparse path
         ref = solve_symmetric(K, M, n_modes=9, dense_below=10**9)
         assert ref.method == "dense"
         lam, X = ref.omega2, ref.vectors

@@ -117,7 +117,9 @@ def test_block_lanczos_returns_both_members_of_double_eigenvalues():
     # on any OpenBLAS kernel, 7e-14 with its AVX2 loops)
     assert_allclose(omega2[0:6:2], omega2[1:6:2], rtol=0, atol=2 * atol)
     result = solve_symmetric(K, M, n_modes=6)
-    assert result.method == "arpack"  # the sparse path (600 DOFs >= DENSE_BELOW)
+    # the sparse path (600 DOFs >= DENSE_BELOW): ARPACK, or block Lanczos where ARPACK
+    # did not converge within its iteration limit
+    assert result.method in ("arpack", "block-lanczos")
     assert result.sturm_count == 6
 
 

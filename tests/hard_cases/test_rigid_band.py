@@ -103,7 +103,7 @@ def test_band_from_zero_returns_every_rigid_mode(case, path, low):
     assert f_lo < np.sqrt(elastic[0]) / (2 * np.pi)
     result, rigid = band_solve(model, (f_lo, f_hi), path)
     expect_rigid = 0 if low == "above threshold" else n_rigid
-    assert result.method == ("dense" if path == "dense" else "arpack")
+    assert result.method in (("dense",) if path == "dense" else ("arpack", "block-lanczos"))
     assert rigid.tolist() == [True] * expect_rigid + [False] * 3, name
     if path == "sparse" and low != "above threshold":
         assert result.sigma < 0  # K - σM positive definite: K itself never factorised

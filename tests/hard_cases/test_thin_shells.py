@@ -67,7 +67,7 @@ ERROR_BOUND = {8: 0.11, 12: 0.05}
 
 
 @pytest.mark.parametrize("distort", [0.0, 0.3], ids=["regular", "distorted"])
-@pytest.mark.parametrize("n", [8, 12], ids=["dense", "arpack"])
+@pytest.mark.parametrize("n", [8, 12], ids=["dense", "sparse"])
 def test_thin_plate_neither_locks_nor_loses_modes(n, distort):
     """Naive: displacement-based shear (locking) makes the a/t = 1e4 plate orders of
     magnitude too stiff; a shift from the median diagonal ratio (1.2e14 rad²/s², set by
@@ -83,7 +83,9 @@ def test_thin_plate_neither_locks_nor_loses_modes(n, distort):
         model = simply_supported(plate_mesh(n, distort), t)
         ref = kirchhoff_hz(t)
         result = fm.modes(model, n_modes=4)
-        assert result.method == ("dense" if n == 8 else "arpack")
+        # 12 x 12: ARPACK, or block Lanczos where ARPACK did not converge within its
+        # iteration limit (which depends on round-off of the starting vector's Krylov space)
+        assert result.method in ({"dense"} if n == 8 else {"arpack", "block-lanczos"})
         assert not result.rigid.any()
         err = result.freq_hz / ref - 1
         assert np.all(err > 0)

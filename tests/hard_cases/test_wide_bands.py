@@ -76,7 +76,7 @@ def test_two_hundred_modes(model_1000):
     model = model_1000
     assert model.n_free == 5999
     result = fm.modes(model, n_modes=200)
-    assert result.method == "arpack"
+    assert result.method in ("arpack", "block-lanczos")  # the sparse path
     assert result.n_modes in (200, 201)  # a pair cut at 200 is returned whole
     assert result.sturm_count == result.n_modes
     assert result.residual.max() < 1e-6  # measured 4.8e-7 (lowest modes: eps λ_max / λ)
